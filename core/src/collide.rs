@@ -1,0 +1,185 @@
+//! Colliders (sphere, capsule, plane) and their penetration queries, shared by both solvers.
+//! A collider may be attached to the head, in which case it is given in the head's frame and
+//! moves with it.
+
+use crate::head::Pose;
+use crate::math::{Math, Real, Vec3};
+
+/// Most colliders a world holds.
+pub const MAX_COLLIDERS: usize = 8;
+
+/// A collider's geometry.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    /// A ball.
+    Sphere {
+        /// Centre, m.
+        centre: Vec3,
+        /// Radius, m.
+        radius: Real,
+    },
+    /// The points within `radius` of the segment `a`–`b`.
+    Capsule {
+        /// One end of the axis, m.
+        a: Vec3,
+        /// The other end, m.
+        b: Vec3,
+        /// Radius, m.
+        radius: Real,
+    },
+    /// The half-space behind a plane: points with `(p − point)·normal < 0` are inside.
+    Plane {
+        /// A point on the plane, m.
+        point: Vec3,
+        /// Unit outward normal.
+        normal: Vec3,
+    },
+}
+
+/// A collider and whether it moves with the head.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Collider {
+    /// Geometry (in the head's frame if `attached_to_head`, else in the world).
+    pub shape: Shape,
+    /// Whether the collider moves rigidly with the head.
+    pub attached_to_head: bool,
+}
+
+/// A node found inside a collider.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Contact {
+    /// Unit outward normal at the closest surface point.
+    pub normal: Vec3,
+    /// How deep the node is, m (> 0).
+    pub depth: Real,
+}
+
+impl Shape {
+    /// This shape moved by `pose`.
+    #[must_use]
+    pub fn transformed(&self, pose: &Pose) -> Shape {
+        match *self {
+            Shape::Sphere { centre, radius } => Shape::Sphere {
+                centre: pose.transform_point(centre),
+                radius,
+            },
+            Shape::Capsule { a, b, radius } => Shape::Capsule {
+                a: pose.transform_point(a),
+                b: pose.transform_point(b),
+                radius,
+            },
+            Shape::Plane { point, normal } => Shape::Plane {
+                point: pose.transform_point(point),
+                normal: pose.transform_vector(normal),
+            },
+        }
+    }
+
+    /// Whether every parameter is finite and in range (radius > 0, unit normal).
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        use crate::math::is_finite;
+        match *self {
+            Shape::Sphere { centre, radius } => is_finite(centre) && radius.is_finite() && radius > 0.0,
+            Shape::Capsule { a, b, radius } => {
+                is_finite(a) && is_finite(b) && radius.is_finite() && radius > 0.0
+            }
+            Shape::Plane { point, normal } => {
+                is_finite(point) && is_finite(normal) && (normal.length_squared() - 1.0).abs() < 1e-4
+            }
+        }
+    }
+
+    /// The contact of point `p` with this shape, if `p` is strictly inside.
+    #[inline]
+    #[must_use]
+    pub fn penetration<M: Math>(&self, p: Vec3) -> Option<Contact> {
+        match *self {
+            Shape::Sphere { centre, radius } => ball::<M>(p, centre, radius),
+            Shape::Capsule { a, b, radius } => {
+                let axis = b - a;
+                let length2 = axis.dot(axis);
+                let t = if length2 > 0.0 {
+                    ((p - a).dot(axis) / length2).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                ball::<M>(p, a + axis * t, radius)
+            }
+            Shape::Plane { point, normal } => {
+                let distance = (p - point).dot(normal);
+                (distance < 0.0).then_some(Contact {
+                    normal,
+                    depth: -distance,
+                })
+            }
+        }
+    }
+}
+
+/// Contact of `p` with the ball of `radius` about `centre`. A point exactly at the centre is
+/// pushed along +y (any fixed direction will do; it must not depend on the target).
+#[inline]
+fn ball<M: Math>(p: Vec3, centre: Vec3, radius: Real) -> Option<Contact> {
+    let d = p - centre;
+    let distance2 = d.dot(d);
+    if distance2 >= radius * radius {
+        return None;
+    }
+    let distance = M::sqrt(distance2);
+    let normal = if distance > 0.0 { d / distance } else { Vec3::Y };
+    Some(Contact {
+        normal,
+        depth: radius - distance,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Libm;
+
+    #[test]
+    fn penetration_of_each_shape() {
+        let sphere = Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius: 1.0,
+        };
+        let c = sphere.penetration::<Libm>(Vec3::new(0.0, 0.5, 0.0)).unwrap();
+        assert_eq!(c.normal, Vec3::Y);
+        assert!((c.depth - 0.5).abs() < 1e-7);
+        assert!(sphere.penetration::<Libm>(Vec3::new(0.0, 1.5, 0.0)).is_none());
+
+        let capsule = Shape::Capsule {
+            a: Vec3::ZERO,
+            b: Vec3::new(2.0, 0.0, 0.0),
+            radius: 0.5,
+        };
+        let c = capsule.penetration::<Libm>(Vec3::new(1.0, 0.0, 0.25)).unwrap();
+        assert_eq!(c.normal, Vec3::Z);
+        assert!((c.depth - 0.25).abs() < 1e-7);
+        assert!(capsule.penetration::<Libm>(Vec3::new(2.6, 0.0, 0.0)).is_none());
+
+        let plane = Shape::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        assert!((plane.penetration::<Libm>(Vec3::new(3.0, -0.2, 1.0)).unwrap().depth - 0.2).abs() < 1e-7);
+        assert!(plane.is_valid() && sphere.is_valid() && capsule.is_valid());
+    }
+
+    #[test]
+    fn transformed_moves_with_the_pose() {
+        let pose = Pose {
+            position: Vec3::new(1.0, 0.0, 0.0),
+            rotation: crate::math::quat_from_axis_angle::<Libm>(Vec3::Z, core::f32::consts::FRAC_PI_2),
+        };
+        let moved = Shape::Sphere {
+            centre: Vec3::X,
+            radius: 1.0,
+        }
+        .transformed(&pose);
+        let Shape::Sphere { centre, .. } = moved else { panic!() };
+        assert!((centre - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
+    }
+}

@@ -1,0 +1,48 @@
+//! # hairsim-core
+//!
+//! An allocation-free `#![no_std]` hair-strand simulator with compile-time strand and node
+//! capacities, for haptic-controller firmware stepping at 1 kHz with a bounded, deterministic
+//! cost: the Kirchhoff-rod model of Kmoch et al. 2009 and Dynamic Follow-The-Leader with shape
+//! preservation of Sánchez-Banderas et al. 2015.
+//!
+//! * [`world::World`] — fixed-capacity strands, colliders and grabs; `step()` each tick.
+//! * [`world::step_strands`] — the same step on any slice of strands (the std harness splits
+//!   strand blocks over threads with it).
+//! * [`strand::Strand`] — rest data apart from state; only state is hashed and rolled back.
+//! * [`effects::Effects`] — what a scene turns on; a stage that is off is never computed.
+//! * [`report::StepReport`] — what a step did: stages, iterations, flags, forces.
+//! * [`math::Math`] — the math backend, a zero-sized type per world.
+//!
+//! Rules the core keeps: no heap, no std, no unsafe, no recursion; every loop bounded by a
+//! capacity or an iteration cap; same inputs give the same bits on every target; `step()`
+//! never panics and never lets a NaN out.
+#![no_std]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod collide;
+pub mod context;
+pub mod effects;
+pub mod error;
+pub mod grab;
+pub mod guard;
+pub mod hash;
+pub mod head;
+pub mod math;
+pub mod params;
+pub mod report;
+pub mod rod;
+pub mod scenes;
+pub mod strand;
+pub mod world;
+
+pub use collide::{Collider, Shape};
+pub use effects::{Effect, Effects};
+pub use error::{BuildError, CapacityError, Error, ParamError};
+pub use grab::{Grab, GrabStatus};
+pub use head::{Pose, Shake};
+pub use math::{DefaultMath, Libm, Math, Real, Vec3};
+pub use params::{Mode, Params, Solver};
+pub use report::{Flags, Stage, StepReport};
+pub use strand::{Material, Strand};
+pub use world::{step_strands, StepInput, World};

@@ -1,0 +1,183 @@
+//! Scalars, vectors and the math backend.
+//!
+//! Every transcendental function and every square root the core evaluates goes through a
+//! [`Math`] backend, a zero-sized type chosen per world. That is what makes results the same
+//! bits on every target: glam's `Vec3`/`Mat3` are scalar code everywhere (and the workspace
+//! turns on glam's `scalar-math`, so `Quat` is too), Rust never contracts `a * b + c` into a
+//! fused multiply-add on its own, and the functions below are the only place a platform could
+//! differ.
+//!
+//! * [`Libm`]: the `libm` crate — bit-identical on x86-64 and thumbv7em.
+//! * `FastMath` (feature `micromath`): micromath's approximate trigonometry, still the correctly
+//!   rounded square root. micromath's own `sqrt` averages ~5 % error and would break every stretch
+//!   bound, so it is never used.
+//! * Firmware may implement [`Math`] itself to route `sqrt` to the Cortex-M4F `VSQRT`
+//!   instruction: IEEE 754 requires a correctly rounded square root, so it gives the same bits
+//!   as `libm::sqrtf` in ~14 cycles instead of a software routine.
+
+pub use glam::{Mat3, Quat, Vec2, Vec3};
+
+/// The simulation's scalar type.
+pub type Real = f32;
+
+/// A math backend: a zero-sized type that provides the few non-arithmetic functions the core
+/// needs. Implementations must give a correctly rounded `sqrt`.
+pub trait Math: Copy + Default + 'static {
+    /// Short name for reports and recordings (`"libm"`, `"fast-math"`, …).
+    const NAME: &'static str;
+    /// Correctly rounded square root (IEEE 754 `squareRoot`).
+    fn sqrt(x: Real) -> Real;
+    /// `(sin x, cos x)`.
+    fn sin_cos(x: Real) -> (Real, Real);
+    /// Four-quadrant arctangent of `y / x`.
+    fn atan2(y: Real, x: Real) -> Real;
+
+    /// Euclidean length of `v`, summed as `x² + y² + z²` left to right.
+    #[inline(always)]
+    fn length(v: Vec3) -> Real {
+        Self::sqrt(v.dot(v))
+    }
+}
+
+/// The `libm` backend: software functions that give the same bits on every target.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Libm;
+
+impl Math for Libm {
+    const NAME: &'static str = "libm";
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        libm::sqrtf(x)
+    }
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        libm::sincosf(x)
+    }
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        libm::atan2f(y, x)
+    }
+}
+
+/// micromath's approximate trigonometry (a few 1e-3 absolute error), `libm`'s correctly
+/// rounded square root. Deterministic too — micromath is plain arithmetic — but its results
+/// differ from [`Libm`]'s, so it has golden hashes of its own.
+#[cfg(feature = "micromath")]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct FastMath;
+
+#[cfg(feature = "micromath")]
+impl Math for FastMath {
+    const NAME: &'static str = "fast-math";
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        libm::sqrtf(x)
+    }
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        let (s, c) = micromath::F32(x).sin_cos();
+        (s.0, c.0)
+    }
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        micromath::F32(y).atan2(micromath::F32(x)).0
+    }
+}
+
+/// The backend a world uses unless it names another: [`Libm`], or `FastMath` when the final
+/// binary turns on the `fast-math` feature.
+#[cfg(not(feature = "fast-math"))]
+pub type DefaultMath = Libm;
+/// The backend a world uses unless it names another.
+#[cfg(feature = "fast-math")]
+pub type DefaultMath = FastMath;
+
+/// `true` when every component of `v` is finite.
+#[inline(always)]
+pub fn is_finite(v: Vec3) -> bool {
+    v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
+}
+
+/// Rotates `v` by the unit quaternion `q` with scalar code written out here, so the order of
+/// every sum is fixed on every target (glam's SSE2 quaternion code sums in another order).
+#[inline(always)]
+pub fn rotate(q: Quat, v: Vec3) -> Vec3 {
+    // v' = v + 2w (u × v) + 2 u × (u × v), u = (x, y, z)
+    let u = Vec3::new(q.x, q.y, q.z);
+    let uv = u.cross(v);
+    let uuv = u.cross(uv);
+    v + (uv * q.w + uuv) * 2.0
+}
+
+/// Hamilton product `a · b` written out in scalar code (see [`rotate`]).
+#[inline(always)]
+pub fn quat_mul(a: Quat, b: Quat) -> Quat {
+    Quat::from_xyzw(
+        a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+        a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+        a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+        a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+    )
+}
+
+/// Conjugate (the inverse of a unit quaternion).
+#[inline(always)]
+pub fn quat_conjugate(q: Quat) -> Quat {
+    Quat::from_xyzw(-q.x, -q.y, -q.z, q.w)
+}
+
+/// Renormalises `q` with the backend's square root; identity if `q` is zero or not finite.
+#[inline(always)]
+pub fn quat_normalize<M: Math>(q: Quat) -> Quat {
+    let n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
+    if n2 > 0.0 && n2.is_finite() {
+        let inv = 1.0 / M::sqrt(n2);
+        Quat::from_xyzw(q.x * inv, q.y * inv, q.z * inv, q.w * inv)
+    } else {
+        Quat::IDENTITY
+    }
+}
+
+/// Unit quaternion for a rotation of `angle` radians about the unit vector `axis`.
+#[inline(always)]
+pub fn quat_from_axis_angle<M: Math>(axis: Vec3, angle: Real) -> Quat {
+    let (s, c) = M::sin_cos(0.5 * angle);
+    Quat::from_xyzw(axis.x * s, axis.y * s, axis.z * s, c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn libm_sqrt_is_correctly_rounded_like_the_hardware() {
+        // The FPU's sqrt is correctly rounded; so must the backend be, bit for bit.
+        let mut x = 1.0e-30_f32;
+        while x < 1.0e30 {
+            assert_eq!(Libm::sqrt(x).to_bits(), x.sqrt().to_bits(), "x = {x:e}");
+            x *= 1.0007;
+        }
+    }
+
+    #[test]
+    fn rotate_matches_glam_rotation() {
+        let q = quat_from_axis_angle::<Libm>(Vec3::new(0.0, 0.6, 0.8), 1.1);
+        let v = Vec3::new(0.3, -1.2, 2.0);
+        assert!((rotate(q, v) - q * v).length() < 1e-6);
+        let p = quat_mul(q, quat_conjugate(q));
+        assert!((p.w - 1.0).abs() < 1e-6 && p.x.abs() < 1e-6);
+    }
+
+    #[cfg(feature = "micromath")]
+    #[test]
+    fn fast_math_is_close_to_libm() {
+        for i in -100..100 {
+            let x = i as f32 * 0.0625;
+            let (s, c) = FastMath::sin_cos(x);
+            let (ls, lc) = Libm::sin_cos(x);
+            assert!((s - ls).abs() < 5e-3 && (c - lc).abs() < 5e-3, "x = {x}");
+        }
+    }
+}

@@ -1,0 +1,194 @@
+//! The step report: what a step did, instead of failing. Stage counters, iterations and
+//! residuals, flags, high-water marks, and the forces a haptic device renders.
+
+use crate::collide::MAX_COLLIDERS;
+use crate::grab::MAX_GRABS;
+use crate::math::{Real, Vec3};
+
+/// The stages of a step, in the order they run.
+///
+/// 1. `Snapshot` — keep the strand's last good state (rollback).
+/// 2. `ExternalForces` — gravity, drag, caller accelerations (SPH, wind).
+/// 3. `ElasticForces` — bending and twist forces (rod, Kmoch Sec. 7.2).
+/// 4. `Twist` — quasistatic twist update (rod, Sec. 6.2 or Newton).
+/// 5. `Integrate` — symplectic Euler (rod) or prediction (DFTL).
+/// 6. `RootCoupling` — nodes 0 and 1 follow the head.
+/// 7. `Shape` — global and local shape constraints (DFTL).
+/// 8. `Projection` — inextensibility, grabs, collisions (rod: fast manifold projection;
+///    DFTL: follow-the-leader).
+/// 9. `Collisions` — contacts found and resolved.
+/// 10. `Velocity` — velocity update from the position change.
+/// 11. `Guard` — non-finite check, rollback.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
+pub enum Stage {
+    /// Keep the last good state.
+    Snapshot = 0,
+    /// Gravity, drag, caller accelerations.
+    ExternalForces = 1,
+    /// Bending and twist forces.
+    ElasticForces = 2,
+    /// Quasistatic twist.
+    Twist = 3,
+    /// Symplectic Euler / prediction.
+    Integrate = 4,
+    /// Roots follow the head.
+    RootCoupling = 5,
+    /// DFTL shape constraints.
+    Shape = 6,
+    /// Inextensibility projection.
+    Projection = 7,
+    /// Collision handling.
+    Collisions = 8,
+    /// Velocity update.
+    Velocity = 9,
+    /// Non-finite check and rollback.
+    Guard = 10,
+}
+
+/// Number of [`Stage`]s.
+pub const STAGE_COUNT: usize = 11;
+
+/// Most strand indices a report names individually (the count is always exact).
+pub const NAMED_STRANDS: usize = 8;
+
+/// Flags raised by a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Flags(u16);
+
+impl Flags {
+    /// An iteration cap was hit before the tolerance was reached.
+    pub const CAP_HIT: Flags = Flags(1);
+    /// A strand turned non-finite and was rolled back.
+    pub const ROLLED_BACK: Flags = Flags(2);
+    /// A grab exceeded its force limit and slipped.
+    pub const GRAB_SLIPPED: Flags = Flags(4);
+    /// The caller's input (head pose, accelerations, grab targets) held a non-finite value,
+    /// which was ignored.
+    pub const BAD_INPUT: Flags = Flags(8);
+
+    /// Whether every flag of `other` is set.
+    #[must_use]
+    pub const fn contains(self, other: Flags) -> bool {
+        self.0 & other.0 == other.0
+    }
+    /// Sets the flags of `other`.
+    pub fn insert(&mut self, other: Flags) {
+        self.0 |= other.0;
+    }
+    /// Whether no flag is set.
+    #[must_use]
+    pub const fn is_empty(self) -> bool {
+        self.0 == 0
+    }
+}
+
+/// What one step did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepReport {
+    /// How many strands each [`Stage`] ran on (a stage that is off stays at 0).
+    pub stage_runs: [u32; STAGE_COUNT],
+    /// Flags raised.
+    pub flags: Flags,
+    /// Most projection (or Newton) iterations any strand used.
+    pub iterations_max: u32,
+    /// Projection iterations summed over strands.
+    pub iterations_total: u32,
+    /// Strands whose projection hit its iteration cap above tolerance.
+    pub cap_hits: u32,
+    /// Largest final projection residual `max |e·e − ê·ê| / ê·ê` over strands.
+    pub residual: Real,
+    /// Largest relative stretch `| |e| − |ê| | / |ê|` of a segment without contact.
+    pub max_stretch: Real,
+    /// Largest relative stretch of a segment with a node pushed out of a collider.
+    pub max_contact_stretch: Real,
+    /// Deepest node inside a collider after the step, m.
+    pub max_penetration: Real,
+    /// Nodes in contact after the step (high-water mark per step).
+    pub contacts: u32,
+    /// Strands rolled back to their last good state.
+    pub rolled_back: u32,
+    /// The first [`NAMED_STRANDS`] rolled-back strands, by index.
+    pub rolled_back_strands: heapless::Vec<u32, NAMED_STRANDS>,
+    /// Force each grab's device feels, N (zero for unused slots).
+    pub grab_forces: [Vec3; MAX_GRABS],
+    /// Grabs that slipped this step (bit `g` for grab `g`).
+    pub grabs_slipped: u8,
+    /// Total contact force on each collider, N.
+    pub collider_forces: [Vec3; MAX_COLLIDERS],
+}
+
+impl Default for StepReport {
+    fn default() -> Self {
+        StepReport {
+            stage_runs: [0; STAGE_COUNT],
+            flags: Flags::default(),
+            iterations_max: 0,
+            iterations_total: 0,
+            cap_hits: 0,
+            residual: 0.0,
+            max_stretch: 0.0,
+            max_contact_stretch: 0.0,
+            max_penetration: 0.0,
+            contacts: 0,
+            rolled_back: 0,
+            rolled_back_strands: heapless::Vec::new(),
+            grab_forces: [Vec3::ZERO; MAX_GRABS],
+            grabs_slipped: 0,
+            collider_forces: [Vec3::ZERO; MAX_COLLIDERS],
+        }
+    }
+}
+
+impl StepReport {
+    /// Counts one strand through `stage`.
+    #[inline(always)]
+    pub fn ran(&mut self, stage: Stage) {
+        self.stage_runs[stage as usize] += 1;
+    }
+
+    /// How many strands `stage` ran on.
+    #[must_use]
+    pub fn runs(&self, stage: Stage) -> u32 {
+        self.stage_runs[stage as usize]
+    }
+
+    /// Records a strand rolled back to its last good state.
+    pub fn roll_back(&mut self, strand: u32) {
+        self.rolled_back += 1;
+        self.flags.insert(Flags::ROLLED_BACK);
+        // The count is exact; beyond the list's capacity the names are dropped.
+        let _ = self.rolled_back_strands.push(strand);
+    }
+
+    /// Folds the report of a later block of strands into this one. Reports must be merged in
+    /// block order (never completion order) so that force sums are the same bits whatever the
+    /// thread count.
+    pub fn merge(&mut self, other: &StepReport) {
+        for (a, b) in self.stage_runs.iter_mut().zip(other.stage_runs) {
+            *a += b;
+        }
+        self.flags.insert(other.flags);
+        self.iterations_max = self.iterations_max.max(other.iterations_max);
+        self.iterations_total += other.iterations_total;
+        self.cap_hits += other.cap_hits;
+        self.residual = self.residual.max(other.residual);
+        self.max_stretch = self.max_stretch.max(other.max_stretch);
+        self.max_contact_stretch = self.max_contact_stretch.max(other.max_contact_stretch);
+        self.max_penetration = self.max_penetration.max(other.max_penetration);
+        self.contacts += other.contacts;
+        self.rolled_back += other.rolled_back;
+        for &s in &other.rolled_back_strands {
+            let _ = self.rolled_back_strands.push(s);
+        }
+        for (a, b) in self.grab_forces.iter_mut().zip(other.grab_forces) {
+            *a += b;
+        }
+        self.grabs_slipped |= other.grabs_slipped;
+        for (a, b) in self.collider_forces.iter_mut().zip(other.collider_forces) {
+            *a += b;
+        }
+    }
+}

@@ -1,0 +1,322 @@
+//! The world and the step pipeline.
+//!
+//! [`step_strands`] is the whole step for a block of strands; it reads top to bottom like the
+//! papers' Algorithm 1, one line per stage, each gated by the scene's effects inside the
+//! solver. [`World`] is the fixed-capacity convenience around it that firmware keeps in a
+//! `static`; the std harness calls [`step_strands`] on strand blocks of its own `Vec`.
+
+use core::marker::PhantomData;
+
+use crate::collide::{Collider, MAX_COLLIDERS};
+use crate::context::StepContext;
+use crate::error::{CapacityError, Error, ParamError};
+use crate::grab::{Grab, GrabStatus, MAX_GRABS};
+use crate::head::Pose;
+use crate::math::{DefaultMath, Math, Vec3};
+use crate::params::{Params, Solver};
+use crate::report::{Flags, Stage, StepReport};
+use crate::strand::Strand;
+
+/// What the caller hands in each tick.
+#[derive(Clone, Copy, Debug)]
+pub struct StepInput<'a> {
+    /// The head's pose at the end of this step.
+    pub head: Pose,
+    /// Optional per-node accelerations (SPH, wind from outside), m/s²: node `i` of strand `s`
+    /// at `s * N + i`. Shorter slices leave the remaining strands without.
+    pub accelerations: Option<&'a [Vec3]>,
+}
+
+/// Steps a block of strands by one `ctx.dt`. `first_strand` is the index of `strands[0]` in
+/// the whole scene (for grabs and the report); `accelerations`, if any, holds `N` entries per
+/// strand of this block. Never panics; a strand that turns non-finite is rolled back.
+pub fn step_strands<M: Math, const N: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    first_strand: u32,
+    grabs: &[Grab],
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    for (k, strand) in strands.iter_mut().enumerate() {
+        let index = first_strand + k as u32;
+        let strand_accelerations = accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
+        // 1. Keep the last good state (quarantine).
+        report.ran(Stage::Snapshot);
+        let last_good = strand.state.clone();
+        // 2. The solver's own stage list (Kmoch Alg. 1 or Sánchez-Banderas Alg. 1).
+        match ctx.params.solver {
+            Solver::Rod => crate::rod::step::step::<M, N>(
+                strand,
+                ctx,
+                grabs,
+                strand_accelerations,
+                report,
+            ),
+            // Refused by `Params::validate` until the DFTL solver lands.
+            Solver::Dftl => {}
+        }
+        // 3. Guard: nothing non-finite leaves the step.
+        crate::guard::check(strand, &last_good, index, report);
+    }
+}
+
+/// A fixed-capacity world: up to `S` strands of up to `N` nodes, stepped with the math
+/// backend `M`. Holds no heap memory; `World::new` is `const`, so a world can live in a
+/// `static`.
+#[derive(Clone, Debug)]
+pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
+    params: Params,
+    strands: heapless::Vec<Strand<N>, S>,
+    colliders: heapless::Vec<Collider, MAX_COLLIDERS>,
+    grabs: heapless::Vec<Grab, MAX_GRABS>,
+    head: Pose,
+    steps: u64,
+    math: PhantomData<M>,
+}
+
+impl<const S: usize, const N: usize, M: Math> Default for World<S, N, M> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
+    /// An empty world with [`Params::DEFAULT`]: usable to initialise a `static`.
+    #[must_use]
+    pub const fn new() -> Self {
+        World {
+            params: Params::DEFAULT,
+            strands: heapless::Vec::new(),
+            colliders: heapless::Vec::new(),
+            grabs: heapless::Vec::new(),
+            head: Pose::IDENTITY,
+            steps: 0,
+            math: PhantomData,
+        }
+    }
+
+    /// An empty world with `params`, after checking them.
+    pub fn with_params(params: Params) -> Result<Self, ParamError> {
+        let mut world = Self::new();
+        world.configure(params)?;
+        Ok(world)
+    }
+
+    /// Replaces the parameters (time step included) after checking them.
+    pub fn configure(&mut self, params: Params) -> Result<(), ParamError> {
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// The parameters.
+    #[must_use]
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Adds a strand; returns its index. A full world returns an error and is unchanged.
+    pub fn add_strand(&mut self, strand: Strand<N>) -> Result<usize, CapacityError> {
+        self.strands
+            .push(strand)
+            .map_err(|_| CapacityError::Strands { capacity: S })?;
+        Ok(self.strands.len() - 1)
+    }
+
+    /// Adds a collider; returns its index.
+    pub fn add_collider(&mut self, collider: Collider) -> Result<usize, Error> {
+        if !collider.shape.is_valid() {
+            return Err(ParamError::OutOfRange {
+                field: "collider",
+                allowed: "finite coordinates, radius > 0, unit plane normal",
+            }
+            .into());
+        }
+        self.colliders
+            .push(collider)
+            .map_err(|_| CapacityError::Colliders {
+                capacity: MAX_COLLIDERS,
+            })?;
+        Ok(self.colliders.len() - 1)
+    }
+
+    /// Adds a grab; returns its index.
+    pub fn add_grab(&mut self, grab: Grab) -> Result<usize, Error> {
+        let strand = self.strands.get(grab.strand as usize);
+        let node_ok = strand.is_some_and(|s| grab.node >= 2 && (grab.node as usize) < s.nodes());
+        if !node_ok || !crate::math::is_finite(grab.target) || !(grab.force_limit > 0.0) {
+            return Err(ParamError::OutOfRange {
+                field: "grab",
+                allowed: "an existing strand, a node from 2 to its last, a finite target, force_limit > 0",
+            }
+            .into());
+        }
+        self.grabs.push(grab).map_err(|_| CapacityError::Grabs {
+            capacity: MAX_GRABS,
+        })?;
+        Ok(self.grabs.len() - 1)
+    }
+
+    /// Moves grab `grab`'s target (ignored for an unknown index or a non-finite target).
+    pub fn set_grab_target(&mut self, grab: usize, target: Vec3) {
+        if let Some(g) = self.grabs.get_mut(grab) {
+            if crate::math::is_finite(target) {
+                g.target = target;
+            }
+        }
+    }
+
+    /// Releases grab `grab`.
+    pub fn release_grab(&mut self, grab: usize) {
+        if let Some(g) = self.grabs.get_mut(grab) {
+            g.status = GrabStatus::Released;
+        }
+    }
+
+    /// The strands.
+    #[must_use]
+    pub fn strands(&self) -> &[Strand<N>] {
+        &self.strands
+    }
+
+    /// The strands, mutable (to set an initial state).
+    pub fn strands_mut(&mut self) -> &mut [Strand<N>] {
+        &mut self.strands
+    }
+
+    /// The colliders.
+    #[must_use]
+    pub fn colliders(&self) -> &[Collider] {
+        &self.colliders
+    }
+
+    /// The grabs.
+    #[must_use]
+    pub fn grabs(&self) -> &[Grab] {
+        &self.grabs
+    }
+
+    /// The head's current pose.
+    #[must_use]
+    pub fn head(&self) -> Pose {
+        self.head
+    }
+
+    /// Steps taken so far.
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The state hash of every strand ([`crate::hash`] documents the order).
+    #[must_use]
+    pub fn state_hash(&self) -> u64 {
+        crate::hash::state_hash(&self.strands)
+    }
+
+    /// Advances the world by one `dt`. Never panics and never fails: what went wrong is in the
+    /// report (a non-finite head pose is ignored and flagged; a strand that diverges is rolled
+    /// back and named).
+    pub fn step(&mut self, input: &StepInput<'_>) -> StepReport {
+        let mut report = StepReport::default();
+        let head = if input.head.is_finite() {
+            input.head
+        } else {
+            report.flags.insert(Flags::BAD_INPUT);
+            self.head
+        };
+        let ctx = StepContext::new(&self.params, self.head, head, &self.colliders);
+        step_strands::<M, N>(
+            &ctx,
+            &mut self.strands,
+            0,
+            &self.grabs,
+            input.accelerations,
+            &mut report,
+        );
+        for (g, grab) in self.grabs.iter_mut().enumerate() {
+            if report.grabs_slipped & (1 << g) != 0 {
+                grab.status = GrabStatus::Slipped;
+            }
+        }
+        self.head = head;
+        self.steps += 1;
+        report
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::{Effect, Effects};
+    use crate::math::{Libm, Real};
+    use crate::strand::Material;
+
+    fn world() -> World<2, 8, Libm> {
+        let mut w = World::with_params(Params {
+            effects: Effects::NONE.with(Effect::Gravity),
+            ..Params::DEFAULT
+        })
+        .unwrap();
+        let points: [Vec3; 6] = core::array::from_fn(|i| Vec3::new(0.01 * i as Real, 0.0, 0.0));
+        w.add_strand(Strand::from_polyline(&points, &Material::HUMAN_HAIR).unwrap())
+            .unwrap();
+        w
+    }
+
+    #[test]
+    fn free_nodes_fall_held_roots_stay() {
+        let mut w = world();
+        let input = StepInput {
+            head: Pose::IDENTITY,
+            accelerations: None,
+        };
+        for _ in 0..100 {
+            w.step(&input);
+        }
+        let s = &w.strands()[0];
+        assert_eq!(s.state.position[0], Vec3::ZERO);
+        assert_eq!(s.state.position[1], Vec3::new(0.01, 0.0, 0.0));
+        // Symplectic Euler: y_k = −g h² k(k+1)/2 after k steps.
+        let expected = -9.81 * 1e-6 * 100.0 * 101.0 / 2.0;
+        assert!((s.state.position[5].y - expected).abs() < 1e-5, "{}", s.state.position[5].y);
+    }
+
+    #[test]
+    fn full_world_refuses_a_strand_and_keeps_the_rest() {
+        let mut w = world();
+        let s = w.strands()[0].clone();
+        assert_eq!(w.add_strand(s.clone()), Ok(1));
+        assert_eq!(w.add_strand(s), Err(CapacityError::Strands { capacity: 2 }));
+        assert_eq!(w.strands().len(), 2);
+    }
+
+    #[test]
+    fn a_non_finite_acceleration_rolls_back_and_is_named() {
+        let mut w = world();
+        let mut acc = [Vec3::ZERO; 8];
+        acc[4] = Vec3::new(Real::NAN, 0.0, 0.0);
+        let before = w.state_hash();
+        let report = w.step(&StepInput {
+            head: Pose::IDENTITY,
+            accelerations: Some(&acc),
+        });
+        assert!(report.flags.contains(Flags::ROLLED_BACK));
+        assert_eq!(report.rolled_back_strands.as_slice(), &[0]);
+        assert_eq!(w.state_hash(), before);
+    }
+
+    #[test]
+    fn a_non_finite_head_pose_is_ignored_and_flagged() {
+        let mut w = world();
+        let mut head = Pose::IDENTITY;
+        head.position.x = Real::INFINITY;
+        let report = w.step(&StepInput {
+            head,
+            accelerations: None,
+        });
+        assert!(report.flags.contains(Flags::BAD_INPUT));
+        assert!(w.strands()[0].is_finite());
+    }
+}

@@ -1,0 +1,11 @@
+//! # hairsim (the std harness)
+//!
+//! Everything around the `no_std` core that a desktop user touches: built-in scenes, runs with
+//! a summary (text or JSON), and — as the issues land — scene files, SPH hair–hair interaction,
+//! record and replay, hair files in and out, pictures and studies.
+
+pub mod builtin;
+pub mod run;
+pub mod summary;
+
+pub use hairsim_core as core;
