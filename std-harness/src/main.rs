@@ -1,5 +1,6 @@
 //! The `hairsim` command line: parse, dispatch to `hairsim::cmd`, print.
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -8,7 +9,8 @@ use hairsim::cmd::{dispatch, Cli};
 fn main() -> ExitCode {
     match dispatch(Cli::parse()) {
         Ok(text) => {
-            println!("{text}");
+            // A reader that stops early (`hairsim scenes | head -1`) is not an error.
+            let _ = writeln!(std::io::stdout().lock(), "{text}");
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -441,7 +441,11 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
 /// Hair files are read by the `hairfile` module; until it is part of this build a scene that
 /// names one is refused, clearly.
 fn hair_file(file: &super::FileSpec, base: &Path) -> FieldError {
-    let path = base.join(&file.path);
+    let path = if base == Path::new(".") {
+        Path::new(&file.path).to_path_buf()
+    } else {
+        base.join(&file.path)
+    };
     FieldError::new(
         "hair.file.path",
         format!(

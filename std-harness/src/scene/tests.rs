@@ -506,7 +506,7 @@ fn hair_errors() {
         &file("path = \"a.hair\"\nup = \"x\"\n"),
         "t.toml:14: hair.file.up: \"x\" is not known, allowed \"y\", \"z\"",
     );
-    refused(&[], &file("path = \"a.hair\"\n"), "t.toml:13: hair.file.path: cannot load \"./a.hair\": hair files arrive with the hairfile module");
+    refused(&[], &file("path = \"a.hair\"\n"), "t.toml:13: hair.file.path: cannot load \"a.hair\": hair files arrive with the hairfile module");
 }
 
 #[test]
