@@ -61,7 +61,7 @@ pub struct Scene {
     /// Air drag per node, kg/s; required when `drag` is on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub drag: Option<f32>,
-    /// Strands per block stepped on one thread (default 64). The scene decides it, never the
+    /// Strands per block stepped on one thread (default 16). The scene decides it, never the
     /// thread count, so results do not depend on `--threads`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub strands_per_block: Option<u32>,

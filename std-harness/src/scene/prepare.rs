@@ -17,7 +17,7 @@ use super::validate::{self, MAX_NODES};
 use super::{HairSpec, MaterialSpec, MotionSpec, Scene, StyleSpec};
 
 /// Strands per block when the scene does not say.
-pub const DEFAULT_BLOCK: usize = 64;
+pub const DEFAULT_BLOCK: usize = 16;
 
 /// One strand to build: its rest polyline (head frame, root first) and material.
 #[derive(Clone, Debug, PartialEq)]
