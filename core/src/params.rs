@@ -171,7 +171,11 @@ impl Params {
             "dftl.global_shape",
             "0 to 1",
         )?;
-        range(fraction(self.dftl.local_shape), "dftl.local_shape", "0 to 1")?;
+        range(
+            fraction(self.dftl.local_shape),
+            "dftl.local_shape",
+            "0 to 1",
+        )?;
         range(
             self.dftl.reference_dt.is_finite() && self.dftl.reference_dt > 0.0,
             "dftl.reference_dt",
@@ -229,7 +233,10 @@ mod tests {
         };
         assert!(matches!(
             shape_on_rod.validate(),
-            Err(ParamError::UnsupportedEffect { effect: "shape", .. })
+            Err(ParamError::UnsupportedEffect {
+                effect: "shape",
+                ..
+            })
         ));
     }
 }
