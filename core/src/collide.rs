@@ -54,6 +54,53 @@ pub struct Contact {
     pub depth: Real,
 }
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for Shape {
+    fn format(&self, f: defmt::Formatter) {
+        use crate::math::DefmtVec3 as V;
+        match *self {
+            Shape::Sphere { centre, radius } => {
+                defmt::write!(f, "Sphere {{ centre: {}, radius: {} }}", V(centre), radius)
+            }
+            Shape::Capsule { a, b, radius } => defmt::write!(
+                f,
+                "Capsule {{ a: {}, b: {}, radius: {} }}",
+                V(a),
+                V(b),
+                radius
+            ),
+            Shape::Plane { point, normal } => {
+                defmt::write!(f, "Plane {{ point: {}, normal: {} }}", V(point), V(normal))
+            }
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Collider {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Collider {{ shape: {}, attached_to_head: {} }}",
+            self.shape,
+            self.attached_to_head
+        )
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Contact {
+    fn format(&self, f: defmt::Formatter) {
+        use crate::math::DefmtVec3 as V;
+        defmt::write!(
+            f,
+            "Contact {{ normal: {}, depth: {} }}",
+            V(self.normal),
+            self.depth
+        )
+    }
+}
+
 impl Shape {
     /// This shape moved by `pose`.
     #[must_use]

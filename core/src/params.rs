@@ -84,7 +84,6 @@ pub struct DftlParams {
 
 /// Everything a world needs to know besides its strands, colliders and grabs.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Params {
     /// The model.
     pub solver: Solver,
@@ -195,6 +194,26 @@ impl Params {
             });
         }
         Ok(())
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Params {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Params {{ solver: {}, dt: {}, effects: {}, mode: {}, gravity: [{}, {}, {}], drag: {}, rod: {}, dftl: {} }}",
+            self.solver,
+            self.dt,
+            self.effects,
+            self.mode,
+            self.gravity.x,
+            self.gravity.y,
+            self.gravity.z,
+            self.drag,
+            self.rod,
+            self.dftl
+        )
     }
 }
 
