@@ -193,6 +193,14 @@ pub fn run(loaded: &Loaded, options: &RunOptions) -> Result<Summary> {
     dispatch(loaded, options, &Inputs::Scene)
 }
 
+/// Runs the built-in scene `name` (what `hairsim run NAME` runs).
+pub fn run_builtin(name: &str, options: &RunOptions) -> Result<Summary> {
+    if builtin::find(name).is_none() {
+        bail!("{name}: not a built-in scene (see `hairsim scenes`)");
+    }
+    run(&load(name, &HairFileOptions::default())?, options)
+}
+
 /// Replays a recording: the scene it holds, driven by its inputs, checked against its hashes.
 /// Fails at the first checkpoint whose hash differs.
 pub fn replay(path: &Path, threads: usize) -> Result<Summary> {
