@@ -231,3 +231,30 @@ fn out_is_refused_until_the_export_module_lands() {
     .to_string();
     assert!(e.contains("arrive with the export module"), "{e}");
 }
+
+#[test]
+fn run_options_are_range_checked() {
+    let loaded = load("stand-2", &HairFileOptions::default()).unwrap();
+    let refused = |options: RunOptions| run(&loaded, &options).unwrap_err().to_string();
+    assert_eq!(
+        refused(RunOptions {
+            threads: 0,
+            ..RunOptions::default()
+        }),
+        "--threads: 0 is out of range, allowed 1 to 1024"
+    );
+    assert_eq!(
+        refused(RunOptions {
+            every: Some(0),
+            ..RunOptions::default()
+        }),
+        "--every: 0 is out of range, allowed 1 or more steps"
+    );
+    assert_eq!(
+        refused(RunOptions {
+            steps: Some(0),
+            ..RunOptions::default()
+        }),
+        "--steps: 0 is out of range, allowed 1 or more"
+    );
+}

@@ -191,7 +191,6 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
         },
         ..defaults
     };
-    params.validate().map_err(param_field)?;
     let steps = match (scene.steps, scene.duration) {
         (Some(steps), _) => steps,
         (None, Some(duration)) => (f64::from(duration) / f64::from(scene.dt)).round() as u64,
@@ -370,6 +369,9 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
             },
         });
     }
+
+    // Last, so that the scene's own checks (which name their fields) speak first.
+    params.validate().map_err(param_field)?;
 
     let motion = match scene.head.as_ref().and_then(|h| h.motion.as_ref()) {
         None | Some(MotionSpec::Still) => Motion::Still,

@@ -676,6 +676,12 @@ fn the_dftl_solver_refuses_what_it_cannot_do() {
         "",
         "t.toml:6: effects[1]: the dftl solver cannot do \"bending\"",
     );
+    let grab = "[[grabs]]\nstrand = 0\nnode = 3\nforce_limit = 1.0\npath = [{ time = 0.0, target = [0.1, 0.0, 0.0] }]\n";
+    refused(
+        &dftl,
+        grab,
+        "t.toml:14: grabs[0].node: the dftl solver cannot grab mid-strand (node 3), allowed the tip, node 4",
+    );
 }
 
 #[test]
