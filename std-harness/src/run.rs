@@ -50,16 +50,16 @@ pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
     let path = Path::new(spec);
     let lower = spec.to_ascii_lowercase();
     if lower.ends_with(".hair") || lower.ends_with(".tfx") {
-        let scene = crate::hairscene::scene_for_hair_file(path, hair);
-        let file = format!("{spec} (default scene)");
-        let prepared = scene.prepare().map_err(|e| {
+        let scene_error = |e: crate::scene::FieldError| {
             anyhow!(SceneError {
-                file,
+                file: format!("{spec} (default scene)"),
                 line: 0,
                 field: e.field,
-                message: e.message
+                message: e.message,
             })
-        })?;
+        };
+        let scene = crate::hairscene::scene_for_hair_file(path, hair).map_err(scene_error)?;
+        let prepared = scene.prepare().map_err(scene_error)?;
         return Ok(Loaded {
             source: spec.to_string(),
             scene,
