@@ -6,6 +6,7 @@
 
 pub mod builtin;
 pub mod run;
+pub mod sph;
 pub mod summary;
 
 pub use hairsim_core as core;
