@@ -9,3 +9,6 @@ pub mod run;
 pub mod summary;
 
 pub use hairsim_core as core;
+pub mod export;
+pub mod hairfile;
+pub mod picture;

@@ -1,0 +1,5 @@
+//! Pictures.
+/// Picture error.
+#[derive(Debug, thiserror::Error)]
+#[error("picture")]
+pub struct PictureError;
