@@ -106,7 +106,12 @@ mod tests {
             write_hair(Vec::new(), &long, 1e-4),
             Err(ExportError::TooLong { points: 65_537, .. })
         ));
-        let at_limit = vec![vec![Vec3::ZERO; 65_536], vec![Vec3::ONE; 2]];
+        let line = |n: usize| {
+            (0..n)
+                .map(|i| Vec3::new(i as f32, 0.0, 0.0))
+                .collect::<Vec<_>>()
+        };
+        let at_limit = vec![line(65_536), line(2)];
         let mut bytes = Vec::new();
         write_hair(&mut bytes, &at_limit, 1e-4).unwrap();
         let model = read_hair(&bytes, &ReadOptions::default()).unwrap();

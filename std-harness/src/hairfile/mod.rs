@@ -62,6 +62,11 @@ pub struct ReadOptions {
     pub nodes: Option<usize>,
     /// Keep at most this many strands, picked evenly through the file (`None`: all of them).
     pub max_strands: Option<usize>,
+    /// Drop strands not longer than this (after scaling), counting them in
+    /// [`HairModel::dropped_short`]: real files hold degenerate strands (AMD's Ratboy has strands
+    /// of 10⁻⁵ units beside a median of 0.08) that the simulator would refuse. The default, 0,
+    /// drops only strands of zero length.
+    pub min_length: f32,
 }
 
 impl Default for ReadOptions {
@@ -71,6 +76,7 @@ impl Default for ReadOptions {
             up_axis: UpAxis::Y,
             nodes: None,
             max_strands: None,
+            min_length: 0.0,
         }
     }
 }
@@ -82,7 +88,8 @@ pub struct HairModel {
     pub strands: Vec<Vec<Vec3>>,
     /// Strands in the file.
     pub file_strands: usize,
-    /// Strands dropped because they had fewer than two points (nothing to simulate).
+    /// Strands dropped because they had fewer than two points or were not longer than
+    /// [`ReadOptions::min_length`] (nothing to simulate).
     pub dropped_short: usize,
 }
 
@@ -243,6 +250,11 @@ impl ReadOptions {
         if matches!(self.nodes, Some(n) if n < 2) {
             return Err(HairFileError::BadOption("nodes must be at least 2"));
         }
+        if !(self.min_length.is_finite() && self.min_length >= 0.0) {
+            return Err(HairFileError::BadOption(
+                "min_length must be finite and >= 0",
+            ));
+        }
         if self.max_strands == Some(0) {
             return Err(HairFileError::BadOption("max_strands must be at least 1"));
         }
@@ -255,8 +267,9 @@ impl ReadOptions {
             Some(k) if k < file_strands => {
                 // Strand i is kept when it is the first at or after a multiple of file/k:
                 // exactly k strands, evenly spread, decided without a list.
+                // That is, i = ⌈m·n/k⌉ for some m: ⌊(i−1)k/n⌋ < ⌊ik/n⌋ (and i = 0 for m = 0).
                 let (i, n, k) = (strand as u128, file_strands as u128, k as u128);
-                (i * k).div_ceil(n) != ((i + 1) * k).div_ceil(n)
+                i == 0 || (i * k) / n != ((i - 1) * k) / n
             }
             _ => true,
         }
@@ -306,6 +319,10 @@ where
                 });
             }
             polyline.push(p);
+        }
+        if polyline_length(&polyline) <= options.min_length {
+            model.dropped_short += 1;
+            continue;
         }
         let kept = match options.nodes {
             Some(n) => resample_polyline(&polyline, n),
