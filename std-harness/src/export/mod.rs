@@ -22,7 +22,7 @@ use hairsim_core::Vec3;
 
 pub use hair::write_hair;
 pub use obj::{read_obj, write_obj};
-pub use outdir::OutDir;
+pub use outdir::{OutDir, OutOptions};
 pub use ply::{read_ply, write_ply};
 pub use seeds::{fuzz_seeds, write_fuzz_seeds};
 pub use tfx::write_tfx;
