@@ -26,8 +26,8 @@ pub struct OutOptions {
     pub gif_delay_centiseconds: u16,
     /// GIF size in pixels (smaller than the still: a GIF frame is quantised and kept whole).
     pub gif_size: (u32, u32),
-    /// Colours and widths.
-    pub style: Style,
+    /// Colours and widths; `None`: [`Style::for_strand_count`] of the first frame drawn.
+    pub style: Option<Style>,
 }
 
 impl Default for OutOptions {
@@ -40,7 +40,7 @@ impl Default for OutOptions {
             gif: true,
             gif_delay_centiseconds: 4,
             gif_size: (400, 400),
-            style: Style::default(),
+            style: None,
         }
     }
 }
@@ -119,7 +119,7 @@ impl OutDir {
                 self.gif = Some(GifWriter::new(
                     file,
                     camera,
-                    self.options.style,
+                    self.style(strands.len()),
                     self.options.gif_delay_centiseconds,
                 )?);
                 self.written.push(path);
@@ -129,6 +129,12 @@ impl OutDir {
             }
         }
         Ok(())
+    }
+
+    fn style(&self, strands: usize) -> Style {
+        self.options
+            .style
+            .unwrap_or_else(|| Style::for_strand_count(strands))
     }
 
     /// Writes `final.obj` and `final.png` (camera fitted to this frame) and closes `run.gif`.
@@ -147,10 +153,8 @@ impl OutDir {
         let (w, h) = self.options.picture_size;
         let camera = Camera::fit_frame(strands, colliders, self.options.view, w, h);
         let png = self.dir.join("final.png");
-        std::fs::write(
-            &png,
-            render_png(strands, colliders, &camera, &self.options.style)?,
-        )?;
+        let style = self.style(strands.len());
+        std::fs::write(&png, render_png(strands, colliders, &camera, &style)?)?;
         self.written.push(png);
         if let Some(gif) = self.gif.take() {
             let mut file = gif.finish()?;

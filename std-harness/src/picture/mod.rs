@@ -11,8 +11,7 @@ mod gif_writer;
 
 use hairsim_core::{Shape, Vec3};
 use tiny_skia::{
-    Color, FillRule, GradientStop, LineCap, LinearGradient, Paint, PathBuilder, Pixmap, Point,
-    Shader, SpreadMode, Stroke, Transform,
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Point, Stroke, Transform,
 };
 
 pub use camera::{Camera, View};
@@ -51,7 +50,7 @@ pub struct Style {
     pub root: [u8; 3],
     /// Strand colour at the tip.
     pub tip: [u8; 3],
-    /// Strand stroke width, pixels.
+    /// Strand stroke width, pixels (≤ 1: anti-aliased hairlines, much faster to draw).
     pub strand_width: f32,
     /// Collider fill.
     pub collider_fill: [u8; 3],
@@ -67,10 +66,28 @@ impl Default for Style {
             background: [250, 250, 247],
             root: [58, 32, 18],
             tip: [222, 168, 84],
-            strand_width: 1.5,
+            strand_width: 1.0,
             collider_fill: [196, 204, 214],
             collider_edge: [96, 106, 120],
             plane_fill: [226, 228, 222],
+        }
+    }
+}
+
+impl Style {
+    /// The default style with a strand width suited to `strands` strands: 2 px for a few
+    /// strands (≤ 64), 1.5 px up to 1000, 1 px beyond (where tiny-skia's fast anti-aliased
+    /// hairlines also keep a 150 000-segment frame near 0.2–0.5 s at 400×400).
+    #[must_use]
+    pub fn for_strand_count(strands: usize) -> Style {
+        let strand_width = match strands {
+            0..=64 => 2.0,
+            65..=1000 => 1.5,
+            _ => 1.0,
+        };
+        Style {
+            strand_width,
+            ..Style::default()
         }
     }
 }
@@ -86,23 +103,100 @@ fn mix(a: [u8; 3], b: [u8; 3], t: f32) -> [u8; 3] {
     [channel(0), channel(1), channel(2)]
 }
 
-/// Something to paint, at a depth along the view direction (larger is farther).
-enum Item {
-    /// A strand segment shaded from `colours.0` at `a` to `colours.1` at `b`.
-    Segment {
-        a: Point,
-        b: Point,
-        colours: ([u8; 3], [u8; 3]),
-    },
-    Disc {
-        centre: Point,
-        radius: f32,
-    },
-    Stadium {
-        a: Point,
-        b: Point,
-        radius: f32,
-    },
+/// Number of steps in the root → tip colour ramp.
+const SHADES: usize = 32;
+
+/// Fewest colour steps along a strand: a strand with fewer segments is cut into pieces.
+const MIN_STEPS: usize = 8;
+
+/// A straight piece of a strand in one shade, in pixels.
+struct Piece {
+    shade: u8,
+    a: Point,
+    b: Point,
+}
+
+/// Strokes `pieces` (in strand order), each run of consecutive connected pieces of one shade
+/// as one polyline. Small paths matter: tiny-skia fills a stroked outline row by row over its
+/// bounding box, so paths gathering far-apart pieces cost far more than many local ones.
+fn draw_pieces(pixmap: &mut Pixmap, style: &Style, pieces: &[Piece]) {
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
+    let stroke = Stroke {
+        width: style.strand_width,
+        line_cap: LineCap::Round,
+        line_join: LineJoin::Round,
+        ..Stroke::default()
+    };
+    for run in pieces.chunk_by(|x, y| x.shade == y.shade && x.b == y.a) {
+        let t = (f32::from(run[0].shade) + 0.5) / SHADES as f32;
+        paint.set_color(colour(mix(style.root, style.tip, t)));
+        let mut path = PathBuilder::new();
+        path.move_to(run[0].a.x, run[0].a.y);
+        for piece in run {
+            path.line_to(piece.b.x, piece.b.y);
+        }
+        if let Some(path) = path.finish() {
+            pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+        }
+    }
+}
+
+/// A collider's picture.
+enum Solid {
+    Disc { centre: Point, radius: f32 },
+    Stadium { a: Point, b: Point, radius: f32 },
+}
+
+fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid) {
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
+    match *solid {
+        Solid::Disc { centre, radius } => {
+            if let Some(path) = PathBuilder::from_circle(centre.x, centre.y, radius.max(0.5)) {
+                paint.set_color(colour(style.collider_fill));
+                pixmap.fill_path(
+                    &path,
+                    &paint,
+                    FillRule::Winding,
+                    Transform::identity(),
+                    None,
+                );
+                paint.set_color(colour(style.collider_edge));
+                let edge = Stroke {
+                    width: 1.5,
+                    ..Stroke::default()
+                };
+                pixmap.stroke_path(&path, &paint, &edge, Transform::identity(), None);
+            }
+        }
+        Solid::Stadium { a, b, radius } => {
+            // The projection of a capsule is a stroke of its axis with round caps: outline
+            // first (a little wider), then the fill.
+            let mut path = PathBuilder::new();
+            path.move_to(a.x, a.y);
+            // A zero-length axis still gets round caps from a tiny nudge.
+            path.line_to(b.x + 1e-3, b.y);
+            if let Some(path) = path.finish() {
+                for (c, w) in [
+                    (style.collider_edge, 2.0 * radius + 3.0),
+                    (style.collider_fill, 2.0 * radius),
+                ] {
+                    paint.set_color(colour(c));
+                    let stroke = Stroke {
+                        width: w.max(1.0),
+                        line_cap: LineCap::Round,
+                        ..Stroke::default()
+                    };
+                    pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+                }
+            }
+        }
+    }
 }
 
 /// Draws one frame: `strands` (polylines, root first) and `colliders` (world coordinates —
@@ -136,14 +230,15 @@ pub fn render<S: AsRef<[Vec3]>>(
         }
     }
 
-    let mut items: Vec<(f32, Item)> = Vec::new();
+    // Colliders far to near (a stable sort keeps the caller's order among equal depths).
+    let mut solids: Vec<(f32, Solid)> = Vec::new();
     for shape in colliders {
         match *shape {
             Shape::Sphere { centre, radius } => {
                 let (c, depth) = camera.project(centre);
-                items.push((
+                solids.push((
                     depth,
-                    Item::Disc {
+                    Solid::Disc {
                         centre: c,
                         radius: radius * camera.scale,
                     },
@@ -151,9 +246,9 @@ pub fn render<S: AsRef<[Vec3]>>(
             }
             Shape::Capsule { a, b, radius } => {
                 let ((pa, da), (pb, db)) = (camera.project(a), camera.project(b));
-                items.push((
+                solids.push((
                     0.5 * (da + db),
-                    Item::Stadium {
+                    Solid::Stadium {
                         a: pa,
                         b: pb,
                         radius: radius * camera.scale,
@@ -163,95 +258,46 @@ pub fn render<S: AsRef<[Vec3]>>(
             Shape::Plane { .. } => {}
         }
     }
+    solids.sort_by(|x, y| y.0.total_cmp(&x.0));
+
+    // Strand pieces are sorted into layers: layer k holds the pieces with k colliders behind
+    // them (by midpoint depth), drawn after those k colliders and before the rest. Each piece
+    // has one shade of the root → tip ramp (SHADES steps).
+    let mut layers: Vec<Vec<Piece>> = (0..=solids.len()).map(|_| Vec::new()).collect();
     for strand in strands {
         let strand = strand.as_ref();
-        let last = strand.len().saturating_sub(1).max(1) as f32;
+        let segments = strand.len().saturating_sub(1).max(1);
+        // Coarse strands are cut into pieces so the ramp shows at least MIN_STEPS steps; finer
+        // strands are not (every piece costs a stroke).
+        let pieces = MIN_STEPS.div_ceil(segments);
         for (j, pair) in strand.windows(2).enumerate() {
             if !(pair[0].is_finite() && pair[1].is_finite()) {
                 continue;
             }
             let ((a, da), (b, db)) = (camera.project(pair[0]), camera.project(pair[1]));
-            let colours = (
-                mix(style.root, style.tip, j as f32 / last),
-                mix(style.root, style.tip, (j + 1) as f32 / last),
-            );
-            items.push((0.5 * (da + db), Item::Segment { a, b, colours }));
+            let depth = 0.5 * (da + db);
+            let layer = solids.iter().take_while(|(d, _)| *d > depth).count();
+            let Some(layer) = layers.get_mut(layer) else {
+                continue;
+            };
+            let at = |u: f32| Point::from_xy(a.x + (b.x - a.x) * u, a.y + (b.y - a.y) * u);
+            for q in 0..pieces {
+                let (u0, u1) = (q as f32 / pieces as f32, (q + 1) as f32 / pieces as f32);
+                let t = (j as f32 + 0.5 * (u0 + u1)) / segments as f32;
+                let shade = ((t * SHADES as f32) as usize).min(SHADES - 1) as u8;
+                layer.push(Piece {
+                    shade,
+                    a: at(u0),
+                    b: at(u1),
+                });
+            }
         }
     }
-    // Far to near; a stable sort keeps strand order among equal depths (deterministic).
-    items.sort_by(|x, y| y.0.total_cmp(&x.0));
 
-    let mut paint = Paint {
-        anti_alias: true,
-        ..Paint::default()
-    };
-    let strand_stroke = Stroke {
-        width: style.strand_width,
-        line_cap: LineCap::Round,
-        ..Stroke::default()
-    };
-    for (_, item) in &items {
-        match *item {
-            Item::Segment { a, b, colours } => {
-                // A gradient along the segment, so even coarse strands shade smoothly root → tip.
-                paint.shader = LinearGradient::new(
-                    a,
-                    b,
-                    vec![
-                        GradientStop::new(0.0, colour(colours.0)),
-                        GradientStop::new(1.0, colour(colours.1)),
-                    ],
-                    SpreadMode::Pad,
-                    Transform::identity(),
-                )
-                .unwrap_or(Shader::SolidColor(colour(colours.0)));
-                let mut path = PathBuilder::new();
-                path.move_to(a.x, a.y);
-                path.line_to(b.x, b.y);
-                if let Some(path) = path.finish() {
-                    pixmap.stroke_path(&path, &paint, &strand_stroke, Transform::identity(), None);
-                }
-            }
-            Item::Disc { centre, radius } => {
-                if let Some(path) = PathBuilder::from_circle(centre.x, centre.y, radius.max(0.5)) {
-                    paint.set_color(colour(style.collider_fill));
-                    pixmap.fill_path(
-                        &path,
-                        &paint,
-                        FillRule::Winding,
-                        Transform::identity(),
-                        None,
-                    );
-                    paint.set_color(colour(style.collider_edge));
-                    let edge = Stroke {
-                        width: 1.5,
-                        ..Stroke::default()
-                    };
-                    pixmap.stroke_path(&path, &paint, &edge, Transform::identity(), None);
-                }
-            }
-            Item::Stadium { a, b, radius } => {
-                // The projection of a capsule is a stroke of its axis with round caps: outline
-                // first (a little wider), then the fill.
-                let mut path = PathBuilder::new();
-                path.move_to(a.x, a.y);
-                // A zero-length axis still gets round caps from a tiny nudge.
-                path.line_to(b.x + 1e-3, b.y);
-                if let Some(path) = path.finish() {
-                    for (c, w) in [
-                        (style.collider_edge, 2.0 * radius + 3.0),
-                        (style.collider_fill, 2.0 * radius),
-                    ] {
-                        paint.set_color(colour(c));
-                        let stroke = Stroke {
-                            width: w.max(1.0),
-                            line_cap: LineCap::Round,
-                            ..Stroke::default()
-                        };
-                        pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
-                    }
-                }
-            }
+    for (k, layer) in layers.iter().enumerate() {
+        draw_pieces(&mut pixmap, style, layer);
+        if let Some((_, solid)) = solids.get(k) {
+            draw_solid(&mut pixmap, style, solid);
         }
     }
     Ok(pixmap)
