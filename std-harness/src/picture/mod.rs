@@ -92,6 +92,19 @@ impl Style {
     }
 }
 
+/// A brightness factor in 0.85 ..= 1.15 fixed by a strand's index (SplitMix64's finaliser).
+fn strand_tint(index: usize) -> f32 {
+    let mut z = (index as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    0.85 + 0.3 * ((z >> 40) as f32 / (1u64 << 24) as f32)
+}
+
+fn brighten(c: [u8; 3], factor: f32) -> [u8; 3] {
+    c.map(|v| (f32::from(v) * factor).round().clamp(0.0, 255.0) as u8)
+}
+
 fn colour([r, g, b]: [u8; 3]) -> Color {
     Color::from_rgba8(r, g, b, 255)
 }
@@ -109,14 +122,14 @@ const SHADES: usize = 32;
 /// Fewest colour steps along a strand: a strand with fewer segments is cut into pieces.
 const MIN_STEPS: usize = 8;
 
-/// A straight piece of a strand in one shade, in pixels.
+/// A straight piece of a strand in one colour, in pixels.
 struct Piece {
-    shade: u8,
+    colour: [u8; 3],
     a: Point,
     b: Point,
 }
 
-/// Strokes `pieces` (in strand order), each run of consecutive connected pieces of one shade
+/// Strokes `pieces` (in strand order), each run of consecutive connected pieces of one colour
 /// as one polyline. Small paths matter: tiny-skia fills a stroked outline row by row over its
 /// bounding box, so paths gathering far-apart pieces cost far more than many local ones.
 fn draw_pieces(pixmap: &mut Pixmap, style: &Style, pieces: &[Piece]) {
@@ -130,9 +143,8 @@ fn draw_pieces(pixmap: &mut Pixmap, style: &Style, pieces: &[Piece]) {
         line_join: LineJoin::Round,
         ..Stroke::default()
     };
-    for run in pieces.chunk_by(|x, y| x.shade == y.shade && x.b == y.a) {
-        let t = (f32::from(run[0].shade) + 0.5) / SHADES as f32;
-        paint.set_color(colour(mix(style.root, style.tip, t)));
+    for run in pieces.chunk_by(|x, y| x.colour == y.colour && x.b == y.a) {
+        paint.set_color(colour(run[0].colour));
         let mut path = PathBuilder::new();
         path.move_to(run[0].a.x, run[0].a.y);
         for piece in run {
@@ -262,10 +274,12 @@ pub fn render<S: AsRef<[Vec3]>>(
 
     // Strand pieces are sorted into layers: layer k holds the pieces with k colliders behind
     // them (by midpoint depth), drawn after those k colliders and before the rest. Each piece
-    // has one shade of the root → tip ramp (SHADES steps).
+    // has one shade of the root → tip ramp (SHADES steps), made a little lighter or darker per
+    // strand (a fixed hash of its index) so dense hair shows strands rather than bands.
     let mut layers: Vec<Vec<Piece>> = (0..=solids.len()).map(|_| Vec::new()).collect();
-    for strand in strands {
+    for (index, strand) in strands.iter().enumerate() {
         let strand = strand.as_ref();
+        let tint = strand_tint(index);
         let segments = strand.len().saturating_sub(1).max(1);
         // Coarse strands are cut into pieces so the ramp shows at least MIN_STEPS steps; finer
         // strands are not (every piece costs a stroke).
@@ -284,9 +298,10 @@ pub fn render<S: AsRef<[Vec3]>>(
             for q in 0..pieces {
                 let (u0, u1) = (q as f32 / pieces as f32, (q + 1) as f32 / pieces as f32);
                 let t = (j as f32 + 0.5 * (u0 + u1)) / segments as f32;
-                let shade = ((t * SHADES as f32) as usize).min(SHADES - 1) as u8;
+                let shade = ((t * SHADES as f32) as usize).min(SHADES - 1);
+                let ramp = mix(style.root, style.tip, (shade as f32 + 0.5) / SHADES as f32);
                 layer.push(Piece {
-                    shade,
+                    colour: brighten(ramp, tint),
                     a: at(u0),
                     b: at(u1),
                 });
