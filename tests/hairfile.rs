@@ -528,3 +528,88 @@ fn real_samples_survive_every_writer() {
         sintel
     );
 }
+
+/// A small deterministic generator (xorshift64*), so the mutation test is repeatable.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// A poor man's fuzzer over our own seeds: header fields set to edge values, random bytes,
+/// truncations. Every outcome must be a clean `Ok` or `Err` within the allocation budget.
+#[test]
+fn mutated_seeds_never_panic_or_over_allocate() {
+    let seeds = hairsim::export::fuzz_seeds().unwrap();
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let edge = |len: usize| {
+        [
+            0,
+            1,
+            2,
+            0xFFFF,
+            0x1_0000,
+            0x7FFF_FFFF,
+            0x8000_0000,
+            u32::MAX,
+            len as u32,
+            len as u32 + 1,
+            128,
+            160,
+        ]
+    };
+    let mut refused = 0;
+    for round in 0..4000 {
+        let (name, seed) = &seeds[round % seeds.len()];
+        let mut bytes = seed.clone();
+        let header = if name.ends_with(".tfx") { 160 } else { 128 };
+        match rng.below(3) {
+            0 => {
+                let at = 4 * rng.below(header / 4);
+                let values = edge(bytes.len());
+                put_u32(&mut bytes, at, values[rng.below(values.len())]);
+            }
+            1 => {
+                for _ in 0..1 + rng.below(4) {
+                    let at = rng.below(bytes.len());
+                    bytes[at] = rng.next() as u8;
+                }
+            }
+            _ => bytes.truncate(rng.below(bytes.len())),
+        }
+        if name.ends_with(".hair") || name.ends_with(".tfx") {
+            let read = if name.ends_with(".hair") {
+                read_hair
+            } else {
+                read_tfx
+            };
+            let (result, peak) = peak_of(|| read(&bytes, &ReadOptions::default()));
+            assert!(
+                peak <= budget(bytes.len()),
+                "{name} round {round}: peak {peak} for {} bytes",
+                bytes.len()
+            );
+            refused += usize::from(result.is_err());
+        } else if let Ok(text) = std::str::from_utf8(&bytes) {
+            let result = match name.rsplit('.').next() {
+                Some("obj") => read_obj(text),
+                Some("ply") => read_ply(text),
+                _ => read_usda(text),
+            };
+            refused += usize::from(result.is_err());
+        }
+    }
+    // The mutations do bite: a good share of the files are refused.
+    assert!(
+        refused > 1000,
+        "only {refused} of 4000 mutated files refused"
+    );
+}

@@ -26,6 +26,9 @@ pub struct OutOptions {
     pub gif_delay_centiseconds: u16,
     /// GIF size in pixels (smaller than the still: a GIF frame is quantised and kept whole).
     pub gif_size: (u32, u32),
+    /// The GIF's camera (its size wins over `gif_size`); `None`: [`Camera::fit_reach`] of the
+    /// first frame, which keeps inextensible strands with fixed roots in the picture.
+    pub gif_camera: Option<Camera>,
     /// Colours and widths; `None`: [`Style::for_strand_count`] of the first frame drawn.
     pub style: Option<Style>,
 }
@@ -40,6 +43,7 @@ impl Default for OutOptions {
             gif: true,
             gif_delay_centiseconds: 4,
             gif_size: (400, 400),
+            gif_camera: None,
             style: None,
         }
     }
@@ -113,7 +117,9 @@ impl OutDir {
         if self.options.gif {
             if self.gif.is_none() {
                 let (w, h) = self.options.gif_size;
-                let camera = Camera::fit_reach(strands, colliders, self.options.view, w, h);
+                let camera = self.options.gif_camera.unwrap_or_else(|| {
+                    Camera::fit_reach(strands, colliders, self.options.view, w, h)
+                });
                 let path = self.dir.join("run.gif");
                 let file = BufWriter::new(File::create(&path)?);
                 self.gif = Some(GifWriter::new(

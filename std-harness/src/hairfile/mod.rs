@@ -184,12 +184,45 @@ pub enum HairFileError {
         /// The operating system's message.
         message: String,
     },
+    /// A text file (OBJ, PLY, USDA) was refused by its reader.
+    #[error("{path}: {message}")]
+    Text {
+        /// The path.
+        path: String,
+        /// The reader's message, with the line.
+        message: String,
+    },
     /// The path's extension names no format this module reads.
-    #[error("{0}: unknown hair file extension (expected .hair or .tfx)")]
+    #[error("{0}: unknown hair file extension (expected .hair, .tfx, .obj, .ply or .usda)")]
     UnknownExtension(String),
 }
 
-/// Reads a `.hair` or `.tfx` file from disk, choosing the reader by extension.
+impl HairModel {
+    /// Applies `options` (up axis, scale, strand picking, length filter, resampling) to
+    /// polylines from elsewhere, e.g. the OBJ/PLY/USDA readers of [`crate::export`].
+    ///
+    /// # Errors
+    /// Bad options, a non-finite coordinate (`offset` is then the vertex's index in the
+    /// flattened point list), or no strand left.
+    pub fn from_polylines<S: AsRef<[Vec3]>>(
+        strands: &[S],
+        options: &ReadOptions,
+    ) -> Result<HairModel, HairFileError> {
+        let mut first = 0;
+        collect_strands(strands.len(), options, |strand| {
+            let points = strands.get(strand).map_or(&[][..], AsRef::as_ref);
+            let start = first;
+            first += points.len();
+            points
+                .iter()
+                .enumerate()
+                .map(move |(k, p)| (start + k, p.to_array()))
+        })
+    }
+}
+
+/// Reads a hair file from disk, choosing the reader by extension: `.hair`, `.tfx`, or our own
+/// text exports `.obj`, `.ply`, `.usda`.
 ///
 /// # Errors
 /// I/O errors, an unknown extension, or anything the readers refuse.
@@ -198,16 +231,31 @@ pub fn read_path(path: &Path, options: &ReadOptions) -> Result<HairModel, HairFi
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let reader: fn(&[u8], &ReadOptions) -> Result<HairModel, HairFileError> = match ext.as_deref() {
-        Some("hair") => read_hair,
-        Some("tfx") => read_tfx,
+    let io = |message: String| HairFileError::Io {
+        path: path.display().to_string(),
+        message,
+    };
+    type TextReader = fn(&str) -> Result<Vec<Vec<Vec3>>, crate::export::TextReadError>;
+    let text_reader: TextReader = match ext.as_deref() {
+        Some("hair") => {
+            let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
+            return read_hair(&bytes, options);
+        }
+        Some("tfx") => {
+            let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
+            return read_tfx(&bytes, options);
+        }
+        Some("obj") => crate::export::read_obj,
+        Some("ply") => crate::export::read_ply,
+        Some("usda") => crate::export::read_usda,
         _ => return Err(HairFileError::UnknownExtension(path.display().to_string())),
     };
-    let bytes = std::fs::read(path).map_err(|e| HairFileError::Io {
+    let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
+    let strands = text_reader(&text).map_err(|e| HairFileError::Text {
         path: path.display().to_string(),
         message: e.to_string(),
     })?;
-    reader(&bytes, options)
+    HairModel::from_polylines(&strands, options)
 }
 
 /// Little-endian field access on a file already checked to be long enough.
@@ -334,4 +382,47 @@ where
         return Err(HairFileError::NoStrands);
     }
     Ok(model)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::export::{save, Format};
+
+    #[test]
+    fn read_path_reads_every_format_we_write() {
+        let dir = std::env::temp_dir().join(format!("hairsim-read-path-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let strands: Vec<Vec<Vec3>> = (0..3)
+            .map(|s| {
+                (0..5)
+                    .map(|i| Vec3::new(s as f32, 0.1 * i as f32, 0.0))
+                    .collect()
+            })
+            .collect();
+        // Z-up files come back rotated: (x, y, z) → (x, z, −y).
+        let options = ReadOptions {
+            up_axis: UpAxis::Z,
+            ..ReadOptions::default()
+        };
+        for format in Format::ALL {
+            let path = dir.join(format!("strands.{}", format.extension()));
+            save(&path, &strands).unwrap();
+            let model = read_path(&path, &options).unwrap();
+            assert_eq!(model.strands.len(), 3, "{format:?}");
+            assert_eq!(model.strands[1][4], Vec3::new(1.0, 0.0, -0.4), "{format:?}");
+        }
+        std::fs::write(dir.join("bad.obj"), "v 0 0 0\nl 1 5\n").unwrap();
+        let e = read_path(&dir.join("bad.obj"), &options).unwrap_err();
+        assert!(e.to_string().contains("line 2"), "{e}");
+        assert!(matches!(
+            read_path(&dir.join("x.abc"), &options),
+            Err(HairFileError::UnknownExtension(_))
+        ));
+        assert!(matches!(
+            read_path(&dir.join("missing.hair"), &options),
+            Err(HairFileError::Io { .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
