@@ -10,3 +10,6 @@ pub mod sph;
 pub mod summary;
 
 pub use hairsim_core as core;
+pub mod export;
+pub mod hairfile;
+pub mod picture;
