@@ -12,8 +12,8 @@ use crate::context::StepContext;
 use crate::error::{CapacityError, Error, ParamError};
 use crate::grab::{Grab, GrabStatus, MAX_GRABS};
 use crate::head::Pose;
-use crate::math::{DefaultMath, Math, Vec3};
-use crate::params::{Params, Solver};
+use crate::math::{DefaultMath, Math, Real, Vec3};
+use crate::params::{DftlCoefficients, Params, Solver};
 use crate::report::{Flags, Stage, StepReport};
 use crate::strand::Strand;
 
@@ -53,8 +53,7 @@ pub fn step_strands<M: Math, const N: usize>(
                 strand_accelerations,
                 report,
             ),
-            // Refused by `Params::validate` until the DFTL solver lands.
-            Solver::Dftl => {}
+            Solver::Dftl => crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report),
         }
         // 3. Guard: nothing non-finite leaves the step.
         crate::guard::check(strand, &last_good, index, report);
@@ -67,6 +66,8 @@ pub fn step_strands<M: Math, const N: usize>(
 #[derive(Clone, Debug)]
 pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     params: Params,
+    /// DFTL's coefficients at `params.dt`, computed once in `configure` (never per step).
+    dftl: DftlCoefficients,
     strands: heapless::Vec<Strand<N>, S>,
     colliders: heapless::Vec<Collider, MAX_COLLIDERS>,
     grabs: heapless::Vec<Grab, MAX_GRABS>,
@@ -87,6 +88,13 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub const fn new() -> Self {
         World {
             params: Params::DEFAULT,
+            dftl: DftlCoefficients {
+                damping: 0.0,
+                global_shape: 0.0,
+                local_shape: 0.0,
+                global_shape_fade: 0.0,
+                local_shape_fade: 0.0,
+            },
             strands: heapless::Vec::new(),
             colliders: heapless::Vec::new(),
             grabs: heapless::Vec::new(),
@@ -107,6 +115,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub fn configure(&mut self, params: Params) -> Result<(), ParamError> {
         params.validate()?;
         self.params = params;
+        self.dftl = params.dftl.at_step(params.dt);
         Ok(())
     }
 
@@ -226,7 +235,15 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             report.flags.insert(Flags::BAD_INPUT);
             self.head
         };
-        let ctx = StepContext::new(&self.params, self.head, head, &self.colliders);
+        let time = (self.steps + 1) as Real * self.params.dt;
+        let ctx = StepContext::with_coefficients(
+            &self.params,
+            self.dftl,
+            self.head,
+            head,
+            &self.colliders,
+        )
+        .at_time(time);
         step_strands::<M, N>(
             &ctx,
             &mut self.strands,
@@ -280,7 +297,11 @@ mod tests {
         assert_eq!(s.state.position[1], Vec3::new(0.01, 0.0, 0.0));
         // Symplectic Euler: y_k = −g h² k(k+1)/2 after k steps.
         let expected = -9.81 * 1e-6 * 100.0 * 101.0 / 2.0;
-        assert!((s.state.position[5].y - expected).abs() < 1e-5, "{}", s.state.position[5].y);
+        assert!(
+            (s.state.position[5].y - expected).abs() < 1e-5,
+            "{}",
+            s.state.position[5].y
+        );
     }
 
     #[test]
