@@ -176,7 +176,7 @@ impl<const N: usize> Strand<N> {
         for j in 0..nodes - 1 {
             let e = points[j + 1] - points[j];
             let length = Libm::length(e);
-            if !(length >= MIN_SEGMENT_LENGTH) {
+            if length.is_nan() || length < MIN_SEGMENT_LENGTH {
                 return Err(BuildError::DegenerateSegment { segment: j });
             }
             if j > 0 {

@@ -154,7 +154,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub fn add_grab(&mut self, grab: Grab) -> Result<usize, Error> {
         let strand = self.strands.get(grab.strand as usize);
         let node_ok = strand.is_some_and(|s| grab.node >= 2 && (grab.node as usize) < s.nodes());
-        if !node_ok || !crate::math::is_finite(grab.target) || !(grab.force_limit > 0.0) {
+        if !node_ok || !crate::math::is_finite(grab.target) || grab.force_limit.is_nan() || grab.force_limit <= 0.0 {
             return Err(ParamError::OutOfRange {
                 field: "grab",
                 allowed: "an existing strand, a node from 2 to its last, a finite target, force_limit > 0",
