@@ -437,3 +437,29 @@ fn block_path_is_bit_identical_to_per_strand() {
     };
     assert_eq!(run(true), run(false));
 }
+
+/// The firmware's DFTL scene: same hash twice, touches its colliders, nothing rolled back.
+#[test]
+fn firmware_dftl_scene_is_deterministic() {
+    use hairsim_core::scenes::firmware_dftl;
+    let run = || {
+        let mut w: Box<World<{ firmware_dftl::STRANDS }, { firmware_dftl::NODES }, Libm>> =
+            Box::default();
+        firmware_dftl::build(&mut w).unwrap();
+        let mut contacts = 0;
+        for k in 0..firmware_dftl::STEPS {
+            let report = w.step(&firmware_dftl::input::<Libm>(k));
+            assert_eq!(report.rolled_back, 0);
+            assert!(report.max_penetration <= 1e-4);
+            contacts += report.contacts;
+        }
+        (w.state_hash(), contacts)
+    };
+    let (hash, contacts) = run();
+    assert_eq!(hash, run().0);
+    assert!(contacts > 0);
+    println!(
+        "firmware-dftl hash after {} steps: {hash:#018x}",
+        firmware_dftl::STEPS
+    );
+}
