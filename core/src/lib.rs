@@ -22,8 +22,11 @@
 
 pub mod collide;
 pub mod context;
+pub mod dftl;
 pub mod effects;
 pub mod error;
+pub mod follow;
+pub mod forces;
 pub mod grab;
 pub mod guard;
 pub mod hash;
@@ -42,7 +45,7 @@ pub use error::{BuildError, CapacityError, Error, ParamError};
 pub use grab::{Grab, GrabStatus};
 pub use head::{Pose, Shake};
 pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
-pub use params::{Mode, Params, Solver};
+pub use params::{DftlCoefficients, DftlParams, Mode, Params, Solver, WindParams};
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};
 pub use world::{step_strands, StepInput, World};

@@ -85,3 +85,110 @@ pub mod firmware {
     /// The head's pose before the first step.
     pub const START: Pose = Pose::IDENTITY;
 }
+
+/// The DFTL scene for the firmware example and the harness (built-in scene `firmware-dftl`):
+/// the same head shaking at 10 rad/s, wavy strands with global and local shape, gusty wind,
+/// gravity and drag, a head sphere and a floor plane.
+pub mod firmware_dftl {
+    use super::*;
+    use crate::params::{Solver, WindParams};
+
+    /// Strands in the scene.
+    pub const STRANDS: usize = 8;
+    /// Node capacity per strand.
+    pub const NODES: usize = 16;
+    /// Steps the firmware runs before it prints the hash.
+    pub const STEPS: u32 = 1000;
+
+    /// The scene's parameters: DFTL, 1 ms, shape and wind on.
+    #[must_use]
+    pub fn params() -> Params {
+        let mut params = Params {
+            solver: Solver::Dftl,
+            effects: Effects::from_slice(&[
+                Effect::Gravity,
+                Effect::Drag,
+                Effect::Inextensibility,
+                Effect::Collisions,
+                Effect::Shape,
+                Effect::Wind,
+            ]),
+            mode: Mode::FixedCost,
+            drag: 2.0e-7,
+            wind: WindParams {
+                direction: Vec3::new(0.6, 0.0, 0.8),
+                strength: 3.0,
+                gust: 0.8,
+                gust_frequency: 2.0,
+                seed: 0x00C0_FFEE,
+            },
+            ..Params::DEFAULT
+        };
+        params.dftl.global_shape_fade = 0.5;
+        params
+    }
+
+    /// Fills an empty world with the scene: `STRANDS` wavy strands of 12 to 16 nodes, 8 mm
+    /// segments, rooted on a 5 cm sphere that moves with the head, above a floor 7.5 cm down that
+    /// the sagging tips reach.
+    pub fn build<M: Math>(world: &mut World<STRANDS, NODES, M>) -> Result<(), Error> {
+        world.configure(params())?;
+        world.add_collider(Collider {
+            shape: Shape::Sphere {
+                centre: Vec3::ZERO,
+                radius: 0.05,
+            },
+            attached_to_head: true,
+        })?;
+        world.add_collider(Collider {
+            shape: Shape::Plane {
+                point: Vec3::new(0.0, -0.075, 0.0),
+                normal: Vec3::Y,
+            },
+            attached_to_head: false,
+        })?;
+        for s in 0..STRANDS {
+            let nodes = 12 + s % 5;
+            let angle = s as Real * 0.785;
+            let (sin, cos) = M::sin_cos(angle);
+            // Alternately up and sideways-down (those reach towards the floor).
+            let up = if s % 2 == 0 { 0.7 } else { -0.35 };
+            let direction = Vec3::new(0.7 * cos, up, 0.7 * sin);
+            let direction = direction * (1.0 / M::length(direction));
+            let side = Vec3::new(-sin, 0.0, cos);
+            let mut points = [Vec3::ZERO; NODES];
+            for (i, p) in points.iter_mut().enumerate().take(nodes) {
+                // Out along the normal with a 3 mm wave: a styled strand, not a straight line.
+                let (wave, _) = M::sin_cos(1.3 * i as Real);
+                *p = direction * (0.05 + 0.008 * i as Real) + side * (0.003 * wave);
+            }
+            world.add_strand(Strand::from_polyline(
+                &points[..nodes],
+                &Material::HUMAN_HAIR,
+            )?)?;
+        }
+        Ok(())
+    }
+
+    /// The input of step `k` (0-based): the head shaking at 10 rad/s, pose at `t = (k+1) dt`.
+    #[must_use]
+    pub fn input<M: Math>(k: u32) -> StepInput<'static> {
+        let t = (k + 1) as Real * params().dt;
+        StepInput {
+            head: Shake::TEN_RAD_PER_S.pose_at::<M>(t),
+            accelerations: None,
+        }
+    }
+
+    /// Builds the scene, runs `steps` steps and returns the state hash.
+    pub fn run<M: Math>(world: &mut World<STRANDS, NODES, M>, steps: u32) -> Result<u64, Error> {
+        build(world)?;
+        for k in 0..steps {
+            world.step(&input::<M>(k));
+        }
+        Ok(world.state_hash())
+    }
+
+    /// The head's pose before the first step.
+    pub const START: Pose = Pose::IDENTITY;
+}

@@ -114,6 +114,8 @@ pub struct RestStrand<const N: usize> {
     pub minor_axis_penalty: Real,
     /// Twist stiffness `β`, N·m².
     pub twist_stiffness: Real,
+    /// DFTL's rest frames and local rest vectors (Sánchez-Banderas 2015 Sec. 3.1).
+    pub dftl: crate::dftl::DftlRest<N>,
 }
 
 /// What a step changes. Only this is hashed, snapshotted and rolled back.
@@ -170,6 +172,7 @@ impl<const N: usize> Strand<N> {
             bending_stiffness: [0.0; N],
             minor_axis_penalty: material.minor_axis_penalty,
             twist_stiffness: material.twist_stiffness(),
+            dftl: crate::dftl::DftlRest::from_polyline::<Libm>(&[]),
         };
         rest.position[..nodes].copy_from_slice(points);
         let lambda = material.linear_density();
@@ -195,6 +198,7 @@ impl<const N: usize> Strand<N> {
         for i in 0..nodes {
             rest.inverse_mass[i] = 1.0 / rest.mass[i];
         }
+        rest.dftl = crate::dftl::DftlRest::from_polyline::<Libm>(points);
         let mut state = StrandState {
             position: [Vec3::ZERO; N],
             velocity: [Vec3::ZERO; N],

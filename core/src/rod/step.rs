@@ -39,7 +39,8 @@ fn external_forces_and_integrate<const N: usize>(
     report.ran(Stage::Integrate);
     let state = &mut strand.state;
     for i in 2..n {
-        let mut a = ctx.gravity - state.velocity[i] * (drag * strand.rest.inverse_mass[i]);
+        let mut a =
+            ctx.gravity + ctx.wind - state.velocity[i] * (drag * strand.rest.inverse_mass[i]);
         if let Some(extra) = accelerations.and_then(|acc| acc.get(i)) {
             a += *extra;
         }
@@ -49,16 +50,25 @@ fn external_forces_and_integrate<const N: usize>(
 }
 
 /// Root coupling: nodes 0 and 1 are prescribed by the head's rigid motion; their velocity is
-/// the position change over the step.
-fn root_coupling<const N: usize>(
+/// the position change over the step. Shared by both solvers (DFTL too).
+pub(crate) fn root_coupling<const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     report: &mut StepReport,
 ) {
     report.ran(Stage::RootCoupling);
     for i in 0..2 {
-        let target = ctx.head.transform_point(strand.rest.position[i]);
-        strand.state.velocity[i] = (target - strand.state.position[i]) * ctx.inv_dt;
-        strand.state.position[i] = target;
+        let (position, velocity) =
+            held_node(ctx, strand.rest.position[i], strand.state.position[i]);
+        strand.state.velocity[i] = velocity;
+        strand.state.position[i] = position;
     }
+}
+
+/// One held root node: its rest position moved with the head, and the velocity that gets it
+/// there from `position` in one step. (The DFTL block path calls it per lane.)
+#[inline(always)]
+pub(crate) fn held_node(ctx: &StepContext, rest_position: Vec3, position: Vec3) -> (Vec3, Vec3) {
+    let target = ctx.head.transform_point(rest_position);
+    (target, (target - position) * ctx.inv_dt)
 }
