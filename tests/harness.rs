@@ -7,7 +7,7 @@ use hairsim::builtin::BUILTINS;
 use hairsim::cmd::run::Args;
 use hairsim::run::{load, run, HairFileOptions, RunOptions};
 use hairsim::scene::Scene;
-use hairsim_core::scenes::firmware;
+use hairsim_core::scenes::{firmware, firmware_dftl};
 use hairsim_core::{DefaultMath, Effect, Effects, Params, Solver, World};
 
 fn workspace() -> PathBuf {
@@ -130,24 +130,34 @@ fn one_and_two_threads_give_the_same_bits() {
 }
 
 #[test]
+fn run_firmware_dftl_gives_the_firmwares_hash() {
+    let summary = hairsim::run::run_builtin("firmware-dftl", &RunOptions::default()).unwrap();
+    let mut world: Box<World<{ firmware_dftl::STRANDS }, { firmware_dftl::NODES }, DefaultMath>> =
+        Box::default();
+    let expected = firmware_dftl::run(&mut world, firmware_dftl::STEPS).unwrap();
+    assert_eq!(summary.state_hash, format!("0x{expected:016x}"));
+    assert!(summary.finite);
+}
+
+#[test]
 fn wind_runs_only_when_called_for_and_is_thread_independent() {
     let text = std::fs::read_to_string(workspace().join("scenes/windy-stand.toml")).unwrap();
     let (scene, prepared) =
         Scene::parse_and_prepare(&text, "windy-stand.toml", Path::new(".")).unwrap();
-    assert!(prepared.wind.is_some());
     let listed: Vec<Effect> = scene
         .effects
         .iter()
         .map(|e| Effect::from_name(e).unwrap())
         .collect();
     assert_eq!(prepared.params.effects, Effects::from_slice(&listed));
-    let loaded = hairsim::run::Loaded {
-        source: "windy".into(),
-        scene: scene.clone(),
-        prepared: prepared.clone(),
-    };
-    let go = |threads, loaded: &hairsim::run::Loaded| {
-        let mut loaded = loaded.clone();
+    assert!(prepared.params.effects.contains(Effect::Wind));
+    assert_eq!(prepared.params.wind.seed, 7);
+    let go = |threads, scene: &Scene| {
+        let mut loaded = hairsim::run::Loaded {
+            source: "windy".into(),
+            scene: scene.clone(),
+            prepared: scene.prepare().unwrap(),
+        };
         loaded.prepared.block = 1;
         run(
             &loaded,
@@ -159,19 +169,56 @@ fn wind_runs_only_when_called_for_and_is_thread_independent() {
         )
         .unwrap()
     };
-    let windy = go(1, &loaded);
-    assert_eq!(windy.state_hash, go(2, &loaded).state_hash);
-    // The same scene without the effect: no wind at all, a different state.
+    let windy = go(1, &scene);
+    assert_eq!(windy.state_hash, go(2, &scene).state_hash);
+    // The same scene without the effect: the [wind] table stays, the wind does not blow.
     let mut calm = scene;
     calm.effects.retain(|e| e != "wind");
-    let calm_prepared = calm.prepare().unwrap();
-    assert!(calm_prepared.wind.is_none());
-    let calm = hairsim::run::Loaded {
-        source: "calm".into(),
-        scene: calm,
-        prepared: calm_prepared,
-    };
+    assert!(!calm
+        .prepare()
+        .unwrap()
+        .params
+        .effects
+        .contains(Effect::Wind));
     assert_ne!(go(1, &calm).state_hash, windy.state_hash);
+}
+
+/// SPH runs when `hair-hair` is on: it changes the state, and not with the thread count.
+#[test]
+fn hair_hair_runs_when_called_for_and_is_thread_independent() {
+    let mut scene = hairsim::builtin::find("head-2")
+        .map(|b| (b.scene)())
+        .unwrap();
+    let go = |threads, scene: &Scene| {
+        let mut loaded = hairsim::run::Loaded {
+            source: "sph".into(),
+            scene: scene.clone(),
+            prepared: scene.prepare().unwrap(),
+        };
+        loaded.prepared.block = 4;
+        run(
+            &loaded,
+            &RunOptions {
+                steps: Some(200),
+                threads,
+                ..RunOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let without = go(1, &scene);
+    scene.effects.push("hair-hair".into());
+    scene.hair_hair = Some(hairsim::scene::HairHairSpec {
+        smoothing_length: Some(0.02),
+        // Pressure everywhere (no rest density to stay under): strands push apart.
+        rest_density: Some(0.0),
+        stiffness: Some(0.5),
+        ..Default::default()
+    });
+    let with = go(1, &scene);
+    assert!(with.finite);
+    assert_ne!(with.state_hash, without.state_hash);
+    assert_eq!(with.state_hash, go(2, &scene).state_hash);
 }
 
 #[test]
@@ -205,31 +252,131 @@ fn a_missing_scene_is_one_clear_error() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.starts_with("no-such-scene: no such scene: not a built-in scene (firmware, stand-1"),
+        e.starts_with(
+            "no-such-scene: no such scene: not a built-in scene (firmware, firmware-dftl, stand-1"
+        ),
         "{e}"
     );
     let e = load("head.hair", &HairFileOptions::default())
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("hair files arrive with the hairfile module"),
+        e.starts_with("head.hair (default scene): hair.file.path: cannot read \"head.hair\""),
         "{e}"
     );
 }
 
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hairsim-harness-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
 #[test]
-fn out_is_refused_until_the_export_module_lands() {
-    let loaded = load("stand-2", &HairFileOptions::default()).unwrap();
-    let e = run(
+fn out_writes_frames_the_final_obj_and_pictures() {
+    let dir = temp_dir("out");
+    let loaded = load("stand-1", &HairFileOptions::default()).unwrap();
+    let summary = run(
         &loaded,
         &RunOptions {
-            out: Some(std::env::temp_dir().join("hairsim-out")),
+            steps: Some(40),
+            every: Some(20),
+            out: Some(dir.clone()),
             ..RunOptions::default()
         },
     )
-    .unwrap_err()
-    .to_string();
-    assert!(e.contains("arrive with the export module"), "{e}");
+    .unwrap();
+    for file in [
+        "final.obj",
+        "final.png",
+        "frames/frame_000020.obj",
+        "frames/frame_000040.obj",
+    ] {
+        assert!(
+            dir.join(file).is_file(),
+            "{file} missing; wrote {:?}",
+            summary.written
+        );
+    }
+    // final.obj: `v` lines strand by strand, one `l` line per strand — leaders and followers.
+    let obj = std::fs::read_to_string(dir.join("final.obj")).unwrap();
+    let lines = obj.lines().filter(|l| l.starts_with("l ")).count();
+    assert_eq!(lines, 3 + 69);
+    assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), 72 * 30);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// A hair file as the scene: read, resampled, a head fitted to its roots, run.
+#[test]
+fn a_hair_file_runs_in_a_default_scene_with_a_fitted_head() {
+    let dir = temp_dir("hairfile");
+    let roots = hairsim::scene::generate::scalp_roots(40, hairsim_core::Vec3::ZERO, 10.0, 1.0);
+    // In centimetres, 60 vertices per strand: --scale 0.01, resampled to the default nodes.
+    let strands: Vec<Vec<hairsim_core::Vec3>> = roots
+        .iter()
+        .map(|(root, normal)| {
+            (0..60)
+                .map(|i| *root + *normal * (0.5 * i as f32))
+                .collect()
+        })
+        .collect();
+    let path = dir.join("wig.hair");
+    hairsim::export::save(&path, &strands).unwrap();
+    let options = HairFileOptions {
+        scale: Some(0.01),
+        up: None,
+    };
+    let loaded = load(path.to_str().unwrap(), &options).unwrap();
+    assert_eq!(loaded.prepared.strands.len(), 40);
+    assert_eq!(
+        loaded.prepared.max_nodes(),
+        hairsim::hairscene::DEFAULT_NODES as usize
+    );
+    assert_eq!(loaded.prepared.colliders.len(), 1);
+    assert!(loaded.prepared.params.effects.contains(Effect::Collisions));
+    let summary = run(
+        &loaded,
+        &RunOptions {
+            steps: Some(50),
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    assert!(summary.finite);
+    // The same file from a scene file, relative to the scene's folder; too many vertices
+    // without `nodes` is an error that says what to do.
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "format = 1\nname = \"wig\"\nsolver = \"rod\"\ndt = 0.001\nsteps = 5\neffects = [\"gravity\"]\n[hair.file]\npath = \"wig.hair\"\nscale = 0.01\nnodes = 20\n",
+    )
+    .unwrap();
+    let (_, prepared) = Scene::load(&scene).unwrap();
+    assert_eq!(prepared.strands.len(), 40);
+    std::fs::write(
+        &scene,
+        "format = 1\nname = \"wig\"\nsolver = \"rod\"\ndt = 0.001\nsteps = 5\neffects = [\"gravity\"]\n[hair.file]\npath = \"wig.hair\"\nscale = 0.001\n",
+    )
+    .unwrap();
+    let dense: Vec<Vec<hairsim_core::Vec3>> = strands
+        .iter()
+        .map(|s| {
+            (0..200)
+                .map(|i| s[0] + (s[1] - s[0]) * (0.2 * i as f32))
+                .collect()
+        })
+        .collect();
+    hairsim::export::save(&path, &dense).unwrap();
+    let e = Scene::load(&scene).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        format!(
+            "{}:7: hair.file.nodes: the file's strands have 200 to 200 vertices, allowed 3 to 128: give nodes = N to resample them",
+            scene.display()
+        )
+    );
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]

@@ -5,8 +5,8 @@
 //! strand counts there include the followers) and Sánchez-Banderas 2015 Table 1
 //! (`mannequin-b`: 500 strands, 8,000 vertices).
 
-use hairsim_core::scenes::firmware;
-use hairsim_core::{Libm, Shake, World};
+use hairsim_core::scenes::{firmware, firmware_dftl};
+use hairsim_core::{DefaultMath, Math, Params, Shake, World};
 
 use crate::scene::generate::{self, Style};
 use crate::scene::{
@@ -34,6 +34,11 @@ pub const BUILTINS: &[Builtin] = &[
         name: "firmware",
         about: "the firmware example's scene: 4 rod strands of 12-15 nodes on a 5 cm head shaking at 10 rad/s, 1000 steps at 1 ms (same hash as under QEMU)",
         scene: firmware_scene,
+    },
+    Builtin {
+        name: "firmware-dftl",
+        about: "the firmware example's DFTL scene: 8 wavy strands with shape and gusty wind on a 5 cm head shaking at 10 rad/s above a floor, 1000 steps at 1 ms (same hash as under QEMU)",
+        scene: firmware_dftl_scene,
     },
     Builtin {
         name: "stand-1",
@@ -161,17 +166,37 @@ fn capsule(a: [f32; 3], b: [f32; 3], radius: f32) -> ColliderSpec {
 /// parameters and collider), so that its hash stays the firmware's.
 #[must_use]
 pub fn firmware_scene() -> Scene {
-    let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, Libm>> = Box::default();
+    let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, DefaultMath>> =
+        Box::default();
     // The firmware scene is fixed and valid; a failure here would leave the world empty and the
     // scene would be refused by its check ("no strands"), never run half-built.
     let _ = firmware::build(&mut world);
-    let params = world.params();
+    from_world("firmware", &world, u64::from(firmware::STEPS))
+}
+
+/// The firmware's DFTL scene, from `hairsim_core::scenes::firmware_dftl`.
+#[must_use]
+pub fn firmware_dftl_scene() -> Scene {
+    let mut world: Box<World<{ firmware_dftl::STRANDS }, { firmware_dftl::NODES }, DefaultMath>> =
+        Box::default();
+    let _ = firmware_dftl::build(&mut world);
+    from_world("firmware-dftl", &world, u64::from(firmware_dftl::STEPS))
+}
+
+/// A scene that builds exactly the strands, colliders and parameters of a core `World` (the
+/// firmware's scenes), with the head shaking at 10 rad/s as their `input` functions do.
+fn from_world<const S: usize, const N: usize, M: Math>(
+    name: &str,
+    world: &World<S, N, M>,
+    steps: u64,
+) -> Scene {
+    let params: &Params = world.params();
     let mut scene = base(
-        "firmware",
-        about("firmware"),
+        name,
+        about(name),
         params.solver.name(),
         params.dt,
-        u64::from(firmware::STEPS),
+        steps,
         &[],
     );
     scene.effects = params
@@ -183,6 +208,27 @@ pub fn firmware_scene() -> Scene {
     scene.gravity = Some(params.gravity.to_array());
     scene.drag = Some(params.drag);
     scene.head = Some(ten_rad_per_s());
+    if params.solver == hairsim_core::Solver::Dftl {
+        let d = params.dftl;
+        scene.dftl = Some(crate::scene::DftlSpec {
+            damping: Some(d.damping),
+            global_shape: Some(d.global_shape),
+            local_shape: Some(d.local_shape),
+            reference_dt: Some(d.reference_dt),
+            global_shape_fade: Some(d.global_shape_fade),
+            local_shape_fade: Some(d.local_shape_fade),
+        });
+    }
+    if params.effects.contains(hairsim_core::Effect::Wind) {
+        let w = params.wind;
+        scene.wind = Some(crate::scene::WindSpec {
+            direction: w.direction.to_array(),
+            strength: w.strength,
+            gust: Some(w.gust),
+            gust_frequency: Some(w.gust_frequency),
+            seed: Some(w.seed),
+        });
+    }
     scene.colliders = world
         .colliders()
         .iter()

@@ -2,9 +2,8 @@
 //! gravity, drag, bending, twist and inextensibility, the head still, and a head sphere fitted
 //! to the strands' roots (with collisions on) when the roots outline one.
 //!
-//! Hook point: reading `.hair`/`.tfx` files is the `hairfile` module's. Until it is part of
-//! this build, [`scene_for_hair_file`] refuses with a clear message; [`scene_around`] is what
-//! it calls with the roots it read.
+//! The file is read (by the `hairfile` module) once here to fit the head to its roots, and
+//! again when the scene is prepared, like any `[hair.file]`.
 
 use std::path::Path;
 
@@ -13,12 +12,26 @@ use hairsim_core::Vec3;
 use crate::run::HairFileOptions;
 use crate::scene::{ColliderSpec, FieldError, FileSpec, HairSpec, Scene, FORMAT};
 
+/// Strands the default scene keeps at most, picked evenly through the file.
+pub const DEFAULT_MAX_STRANDS: u32 = 1000;
+/// Nodes every strand is resampled to in the default scene.
+pub const DEFAULT_NODES: u32 = 24;
+
 /// The default scene for the hair file at `path`.
 pub fn scene_for_hair_file(path: &Path, options: &HairFileOptions) -> Result<Scene, FieldError> {
     // Checked like a scene's [hair.file] table, so --scale and --up get the same messages.
-    let scene = scene_around(path, options, &[]);
-    scene.prepare()?;
-    Ok(scene)
+    let bare = scene_around(path, options, &[]);
+    crate::scene::validate_only(&bare)?;
+    let Some(HairSpec::File(file)) = &bare.hair else {
+        return Ok(bare);
+    };
+    let model = crate::scene::prepare::read_hair_file(file, Path::new("."))?;
+    let roots: Vec<Vec3> = model
+        .strands
+        .iter()
+        .filter_map(|s| s.first().copied())
+        .collect();
+    Ok(scene_around(path, options, &roots))
 }
 
 /// The default scene for the hair file at `path` whose strand roots (after `--scale` and
@@ -82,6 +95,9 @@ pub fn scene_around(path: &Path, options: &HairFileOptions, roots: &[Vec3]) -> S
             path: path.display().to_string(),
             scale: options.scale,
             up: options.up.clone(),
+            nodes: Some(DEFAULT_NODES),
+            max_strands: Some(DEFAULT_MAX_STRANDS),
+            min_length: None,
         })),
         strands: Vec::new(),
         grabs: Vec::new(),

@@ -187,9 +187,6 @@ pub fn run(loaded: &Loaded, options: &RunOptions) -> Result<Summary> {
             bail!("--steps: 0 is out of range, allowed 1 or more");
         }
     }
-    if let Some(dir) = &options.out {
-        output::check(dir, &loaded.prepared.output)?;
-    }
     dispatch(loaded, options, &Inputs::Scene)
 }
 
@@ -308,7 +305,7 @@ fn run_n<const N: usize, M: Math>(
         checkpoints: Vec::new(),
     });
     let mut frames = match &options.out {
-        Some(dir) => Some(output::Frames::new(dir, prepared, every)?),
+        Some(dir) => Some(output::Frames::new(dir, prepared, every, steps)?),
         None => None,
     };
     let mut totals = Totals::default();
@@ -351,7 +348,7 @@ fn run_n<const N: usize, M: Math>(
             }
         }
         if let Some(f) = &mut frames {
-            f.after_step(done, steps, &sim.strands, &sim.head)?;
+            f.after_step(done, &sim.strands, &sim.head)?;
         }
         progress.tick(done);
     }
@@ -367,9 +364,10 @@ fn run_n<const N: usize, M: Math>(
     if let (Some(r), Some(path)) = (&recording, &options.record) {
         r.write(path)?;
     }
-    if let Some(f) = frames {
-        f.finish(&sim.strands, &sim.head)?;
-    }
+    let written = match frames {
+        Some(f) => f.finish(&sim.strands, &sim.head)?,
+        None => Vec::new(),
+    };
     let grabs = !sim.grabs.is_empty();
     Ok(Summary {
         scene: prepared.name.clone(),
@@ -416,6 +414,7 @@ fn run_n<const N: usize, M: Math>(
                 })
                 .collect()
         }),
+        written: written.iter().map(|p| p.display().to_string()).collect(),
         collider_forces: (!sim.colliders.is_empty()).then(|| {
             last.collider_forces[..sim.colliders.len()]
                 .iter()

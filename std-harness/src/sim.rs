@@ -6,13 +6,14 @@
 
 use hairsim_core::context::StepContext;
 use hairsim_core::grab::GrabStatus;
+use hairsim_core::params::DftlCoefficients;
 use hairsim_core::{
     step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
-use crate::scene::motion::Wind;
 use crate::scene::{FieldError, Prepared};
+use crate::sph::Sph;
 
 /// The time-varying inputs of one step (what a recording stores).
 #[derive(Clone, Debug, PartialEq)]
@@ -61,8 +62,10 @@ pub struct Sim<const N: usize, M: Math> {
     pub head: Pose,
     /// Steps taken.
     pub steps: u64,
+    /// The SPH stage, when `hair-hair` is on.
+    pub sph: Option<Sph>,
     block: usize,
-    wind: Option<Wind>,
+    dftl: DftlCoefficients,
     accelerations: Vec<Vec3>,
     pool: Option<rayon::ThreadPool>,
     math: std::marker::PhantomData<M>,
@@ -99,12 +102,15 @@ impl<const N: usize, M: Math> Sim<N, M> {
         } else {
             None
         };
-        let wind = prepared
-            .wind
-            .filter(|_| prepared.params.effects.contains(hairsim_core::Effect::Wind));
+        let sph = match &prepared.sph {
+            Some(params) => {
+                Some(Sph::new(*params, &strands).map_err(|e| FieldError::new("hair-hair", e))?)
+            }
+            None => None,
+        };
         Ok(Sim {
             params: prepared.params,
-            accelerations: if wind.is_some() {
+            accelerations: if sph.is_some() {
                 vec![Vec3::ZERO; strands.len() * N]
             } else {
                 Vec::new()
@@ -114,8 +120,10 @@ impl<const N: usize, M: Math> Sim<N, M> {
             grabs,
             head,
             steps: 0,
+            sph,
             block: prepared.block.max(1),
-            wind,
+            // Computed once, as `World::configure` does (two `powf`, never per step).
+            dftl: prepared.params.dftl.at_step(prepared.params.dt),
             pool,
             math: std::marker::PhantomData,
         })
@@ -152,14 +160,26 @@ impl<const N: usize, M: Math> Sim<N, M> {
             report.flags.insert(Flags::BAD_INPUT);
             self.head
         };
-        let ctx = StepContext::new(&self.params, self.head, head, &self.colliders);
-        let t = crate::sim::time_after(self.steps, self.params.dt);
-        let accelerations = match self.wind {
-            Some(wind) => {
-                wind_accelerations::<N, M>(&wind, t, &self.strands, &mut self.accelerations);
+        let t = time_after(self.steps, self.params.dt);
+        // As `World::step`: coefficients from set-up, the wind at the step's end time.
+        let ctx = StepContext::with_coefficients(
+            &self.params,
+            self.dftl,
+            self.head,
+            head,
+            &self.colliders,
+        )
+        .at_time(t);
+        let accelerations = match &mut self.sph {
+            Some(sph) if ctx.has(hairsim_core::Effect::HairHair) => {
+                let (strands, out, dt) = (&self.strands, &mut self.accelerations, ctx.dt);
+                match &self.pool {
+                    Some(pool) => pool.install(|| sph.accelerations(strands, dt, out)),
+                    None => sph.accelerations(strands, dt, out),
+                }
                 Some(self.accelerations.as_slice())
             }
-            None => None,
+            _ => None,
         };
         let block = self.block;
         let grabs = self.grabs.as_slice();
@@ -212,24 +232,4 @@ fn place<const N: usize>(strand: &mut Strand<N>, head: &Pose) {
         *p = head.transform_point(*p);
     }
     strand.state.root_frame = head.transform_vector(strand.state.root_frame);
-}
-
-/// `a_i = drag · (w(t) − v_i) / m_i` for every node of every strand.
-fn wind_accelerations<const N: usize, M: Math>(
-    wind: &Wind,
-    t: Real,
-    strands: &[Strand<N>],
-    out: &mut [Vec3],
-) {
-    let w = wind.velocity_at::<M>(t);
-    for (strand, acc) in strands.iter().zip(out.chunks_mut(N)) {
-        let n = strand.nodes();
-        let nodes = acc
-            .iter_mut()
-            .zip(&strand.state.velocity[..n])
-            .zip(&strand.rest.inverse_mass[..n]);
-        for ((a, v), inverse_mass) in nodes {
-            *a = (w - *v) * (wind.drag * inverse_mass);
-        }
-    }
 }

@@ -51,6 +51,9 @@ pub struct Summary {
     /// Each grab's status after the last step: held, slipped or released (only with grabs).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grab_status: Option<Vec<String>>,
+    /// Files written by `--out` (empty without it).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub written: Vec<String>,
     /// Each collider's total contact force after the last step, N (only with colliders).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub collider_forces: Option<Vec<[f32; 3]>>,
@@ -112,6 +115,12 @@ impl Summary {
         }
         if let Some(forces) = &self.collider_forces {
             text.push_str(&format!("\ncolliders   {}", vectors(forces)));
+        }
+        if let Some(last) = self.written.last() {
+            text.push_str(&format!(
+                "\nwritten     {} files, last {last}",
+                self.written.len()
+            ));
         }
         text
     }

@@ -156,6 +156,12 @@ pub struct DftlSpec {
     /// s.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reference_dt: Option<f32>,
+    /// How much s_g fades from root to tip (0: constant, 1: zero at the tip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub global_shape_fade: Option<f32>,
+    /// How much s_l fades from root to tip.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub local_shape_fade: Option<f32>,
 }
 
 /// `[head]`.
@@ -349,6 +355,15 @@ pub struct FileSpec {
     /// The file's up axis: `"y"` (default) or `"z"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub up: Option<String>,
+    /// Resample every strand to this many nodes (default: keep the file's vertices).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub nodes: Option<u32>,
+    /// Keep at most this many strands, picked evenly through the file (default: all).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_strands: Option<u32>,
+    /// Drop strands not longer than this, m (default 0.001).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_length: Option<f32>,
 }
 
 /// `[[strands]]`: a generated strand (root, direction, length, nodes, style) or an explicit
@@ -415,38 +430,47 @@ pub struct PathKey {
     pub target: V3,
 }
 
-/// `[wind]`: `a_i = drag · (w(t) − v_i) / m_i` with `w(t) = velocity · (1 + gust · sin 2π f t)`.
+/// `[wind]`: an acceleration on every free node, `a(t) = direction · strength · (1 + gust ·
+/// n(t))`, `n` a seeded smooth noise in `[−1, 1]` (the core's `WindParams`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WindSpec {
-    /// Mean wind velocity, m/s.
-    pub velocity: V3,
-    /// Coupling per node, kg/s.
-    pub drag: f32,
-    /// Gust amplitude as a fraction of the mean (default 0).
+    /// Direction the wind blows towards (normalised).
+    pub direction: V3,
+    /// Mean acceleration, m/s².
+    pub strength: f32,
+    /// Gust amplitude as a fraction of `strength` (default 0.5).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust: Option<f32>,
-    /// Gust frequency, Hz (default 1).
+    /// How often the gust noise picks a new value, Hz (default 1.5).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gust_frequency: Option<f32>,
+    /// Seed of the gust noise (default 24301).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u32>,
 }
 
-/// `[hair-hair]`: SPH parameters (DESIGN.md "SPH hair–hair interaction").
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+/// `[hair-hair]`: SPH parameters (DESIGN.md "SPH hair–hair interaction"); defaults are
+/// the SPH module's.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HairHairSpec {
     /// Smoothing length h, m.
-    pub smoothing_length: f32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub smoothing_length: Option<f32>,
     /// ρ_0, kg/m³.
-    pub rest_density: f32,
-    /// Pressure stiffness k, Pa·m³/kg.
-    pub stiffness: f32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_density: Option<f32>,
+    /// Pressure stiffness k in `p = k (ρ − ρ_0)`, m²/s².
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f32>,
     /// Viscosity µ.
-    pub viscosity: f32,
-    /// Neighbour list cap per particle (default 32).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub viscosity: Option<f32>,
+    /// Neighbour list cap per particle.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_neighbours: Option<u32>,
-    /// Neighbours on the same strand within this many nodes are skipped (default 3).
+    /// Neighbours on the same strand within this many nodes are skipped.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub skip_same_strand: Option<u32>,
 }
@@ -458,12 +482,16 @@ pub struct OutputSpec {
     /// Write a frame every this many steps (default: only the final frame).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub every: Option<u64>,
-    /// Frame formats: any of `"obj"`, `"ply"`, `"hair"`, `"usda"` (default `["obj"]`).
+    /// Frame formats: any of `"obj"`, `"ply"`, `"hair"`, `"usda"`, `"tfx"` (default `["obj"]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub formats: Option<Vec<String>>,
-    /// `"png"` (default), `"gif"` (an animation of the frames) or `"none"`.
+    /// `"png"` (default: `final.png`) or `"gif"` (`final.png` and `run.gif`, an animation of
+    /// the frames).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub picture: Option<String>,
+    /// Camera of the pictures: `"front"` (default), `"back"`, `"side"` or `"top"`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub view: Option<String>,
     /// Picture width, pixels (default 512).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub width: Option<u32>,
@@ -530,6 +558,11 @@ impl Scene {
         // Every field is a plain value, an array or a table: serialisation cannot fail.
         toml::to_string(self).unwrap_or_else(|e| format!("# could not serialise: {e}\n"))
     }
+}
+
+/// Runs only the checks that need no file (what [`Scene::prepare`] runs first).
+pub fn validate_only(scene: &Scene) -> Result<(), FieldError> {
+    validate::check(scene)
 }
 
 /// Places a field error at its line in `text`.

@@ -1,9 +1,7 @@
-//! The time-varying inputs a scene describes: the head's motion, grab paths and wind. Each
+//! The time-varying inputs a scene describes: the head's motion and grab paths. Each
 //! is evaluated once per step on the calling thread (never per strand block), and every
 //! transcendental goes through the math backend `M`, so inputs are the same bits on every
 //! target and thread count.
-
-use std::f32::consts::PI;
 
 use hairsim_core::math::{quat_from_axis_angle, quat_normalize, Quat};
 use hairsim_core::{Math, Pose, Real, Shake, Vec3};
@@ -109,28 +107,6 @@ impl GrabPath {
     #[must_use]
     pub fn released_at(&self, t: Real) -> bool {
         self.release.is_some_and(|r| t >= r)
-    }
-}
-
-/// Wind: `a_i = drag · (w(t) − v_i) / m_i`, `w(t) = velocity · (1 + gust · sin 2π f t)`.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Wind {
-    /// Mean velocity, m/s.
-    pub velocity: Vec3,
-    /// Coupling per node, kg/s.
-    pub drag: Real,
-    /// Gust amplitude (fraction of the mean).
-    pub gust: Real,
-    /// Gust frequency, Hz.
-    pub gust_frequency: Real,
-}
-
-impl Wind {
-    /// The wind velocity at time `t`.
-    #[must_use]
-    pub fn velocity_at<M: Math>(&self, t: Real) -> Vec3 {
-        let (s, _) = M::sin_cos(2.0 * PI * self.gust_frequency * t);
-        self.velocity * (1.0 + self.gust * s)
     }
 }
 

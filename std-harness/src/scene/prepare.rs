@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use hairsim_core::params::{DftlParams, RodParams};
+use hairsim_core::params::{DftlParams, RodParams, WindParams};
 use hairsim_core::{
     Collider, Effect, Effects, Material, Mode, ParamError, Params, Real, Shake, Shape, Solver,
     Strand, Vec3,
@@ -12,7 +12,7 @@ use hairsim_core::{
 
 use super::error::FieldError;
 use super::generate::{self, v3, Follower, Style};
-use super::motion::{GrabPath, Key, Motion, Wind};
+use super::motion::{GrabPath, Key, Motion};
 use super::validate::{self, MAX_NODES};
 use super::{HairSpec, MaterialSpec, MotionSpec, Scene, StyleSpec};
 
@@ -52,8 +52,10 @@ pub struct OutputPlan {
     pub every: Option<u64>,
     /// Frame formats.
     pub formats: Vec<String>,
-    /// `png`, `gif` or `none`.
+    /// `png` (final.png) or `gif` (final.png and run.gif).
     pub picture: String,
+    /// Camera: `front`, `back`, `side` or `top`.
+    pub view: String,
     /// Pixels.
     pub width: u32,
     /// Pixels.
@@ -81,8 +83,8 @@ pub struct Prepared {
     pub grabs: Vec<GrabPlan>,
     /// The head's motion.
     pub motion: Motion,
-    /// Wind, when the effect is on.
-    pub wind: Option<Wind>,
+    /// SPH parameters, when `hair-hair` is on.
+    pub sph: Option<crate::sph::SphParams>,
     /// Followers, drawn around their leaders.
     pub followers: Vec<Follower>,
     /// Output settings.
@@ -187,8 +189,21 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
             global_shape: dftl.global_shape.unwrap_or(defaults.dftl.global_shape),
             local_shape: dftl.local_shape.unwrap_or(defaults.dftl.local_shape),
             reference_dt: dftl.reference_dt.unwrap_or(defaults.dftl.reference_dt),
+            global_shape_fade: dftl
+                .global_shape_fade
+                .unwrap_or(defaults.dftl.global_shape_fade),
+            local_shape_fade: dftl
+                .local_shape_fade
+                .unwrap_or(defaults.dftl.local_shape_fade),
             ..defaults.dftl
         },
+        wind: scene.wind.as_ref().map_or(defaults.wind, |w| WindParams {
+            direction: unit(w.direction),
+            strength: w.strength,
+            gust: w.gust.unwrap_or(defaults.wind.gust),
+            gust_frequency: w.gust_frequency.unwrap_or(defaults.wind.gust_frequency),
+            seed: w.seed.unwrap_or(defaults.wind.seed),
+        }),
         ..defaults
     };
     let steps = match (scene.steps, scene.duration) {
@@ -258,7 +273,14 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
             }
         }
         Some(HairSpec::File(file)) => {
-            return Err(hair_file(file, base));
+            for points in read_hair_file(file, base)?.strands {
+                strands.push(RestSpec {
+                    points,
+                    material: base_material,
+                    tip_stiffness: base_tip,
+                    field: "hair.file".into(),
+                });
+            }
         }
     }
     for (i, s) in scene.strands.iter().enumerate() {
@@ -402,22 +424,28 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
         ),
     };
 
-    let wind = scene
-        .wind
-        .as_ref()
-        .filter(|_| effects.contains(Effect::Wind))
-        .map(|w| Wind {
-            velocity: v3(w.velocity),
-            drag: w.drag,
-            gust: w.gust.unwrap_or(0.0),
-            gust_frequency: w.gust_frequency.unwrap_or(1.0),
-        });
+    let sph = effects.contains(Effect::HairHair).then(|| {
+        let d = crate::sph::SphParams::default();
+        let h = scene.hair_hair.clone().unwrap_or_default();
+        crate::sph::SphParams {
+            smoothing_length: h.smoothing_length.unwrap_or(d.smoothing_length),
+            rest_density: h.rest_density.unwrap_or(d.rest_density),
+            stiffness: h.stiffness.unwrap_or(d.stiffness),
+            viscosity: h.viscosity.unwrap_or(d.viscosity),
+            neighbour_cap: h.max_neighbours.map_or(d.neighbour_cap, |n| n as usize),
+            same_strand_gap: h.skip_same_strand.unwrap_or(d.same_strand_gap),
+        }
+    });
+    if let Some(Err(e)) = sph.as_ref().map(crate::sph::SphParams::validate) {
+        return Err(FieldError::new("hair-hair", e));
+    }
 
     let out = scene.output.clone().unwrap_or_default();
     let output = OutputPlan {
         every: out.every,
         formats: out.formats.unwrap_or_else(|| vec!["obj".into()]),
         picture: out.picture.unwrap_or_else(|| "png".into()),
+        view: out.view.unwrap_or_else(|| "front".into()),
         width: out.width.unwrap_or(512),
         height: out.height.unwrap_or(512),
         followers: out.followers.unwrap_or(true),
@@ -434,25 +462,59 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
         colliders,
         grabs,
         motion,
-        wind,
+        sph,
         followers,
         output,
     })
 }
 
-/// Hair files are read by the `hairfile` module; until it is part of this build a scene that
-/// names one is refused, clearly.
-fn hair_file(file: &super::FileSpec, base: &Path) -> FieldError {
+/// Reads the strands of a `[hair.file]` (via the `hairfile` module), checked for what the
+/// simulator needs: 3 to 128 nodes per strand.
+pub fn read_hair_file(
+    file: &super::FileSpec,
+    base: &Path,
+) -> Result<crate::hairfile::HairModel, FieldError> {
+    use crate::hairfile::{read_path, ReadOptions, UpAxis};
     let path = if base == Path::new(".") {
         Path::new(&file.path).to_path_buf()
     } else {
         base.join(&file.path)
     };
-    FieldError::new(
-        "hair.file.path",
-        format!(
-            "cannot load \"{}\": hair files arrive with the hairfile module, allowed for now: [hair.stand], [hair.scalp] or [[strands]]",
-            path.display()
-        ),
-    )
+    let options = ReadOptions {
+        scale: file.scale.unwrap_or(1.0),
+        up_axis: if file.up.as_deref() == Some("z") {
+            UpAxis::Z
+        } else {
+            UpAxis::Y
+        },
+        nodes: file.nodes.map(|n| n as usize),
+        max_strands: file.max_strands.map(|n| n as usize),
+        min_length: file.min_length.unwrap_or(0.001),
+    };
+    let model = read_path(&path, &options).map_err(|e| {
+        FieldError::new(
+            "hair.file.path",
+            format!("cannot read \"{}\": {e}", path.display()),
+        )
+    })?;
+    let longest = model.strands.iter().map(Vec::len).max().unwrap_or(0);
+    let shortest = model.strands.iter().map(Vec::len).min().unwrap_or(0);
+    if model.strands.is_empty() {
+        return Err(FieldError::new(
+            "hair.file.path",
+            format!(
+                "\"{}\" holds no strand longer than min_length, allowed: a file with strands",
+                path.display()
+            ),
+        ));
+    }
+    if longest > MAX_NODES as usize || shortest < 3 {
+        return Err(FieldError::new(
+            "hair.file.nodes",
+            format!(
+                "the file's strands have {shortest} to {longest} vertices, allowed 3 to {MAX_NODES}: give nodes = N to resample them"
+            ),
+        ));
+    }
+    Ok(model)
 }

@@ -193,17 +193,6 @@ fn top_level_errors() {
         "",
         "t.toml:1: wind: missing: the effect \"wind\" is on, give a [wind] table",
     );
-    refused(
-        &[("[\"gravity\"]", "[\"hair-hair\"]")],
-        "",
-        "t.toml:1: hair-hair: missing: the effect \"hair-hair\" is on, give a [hair-hair] table",
-    );
-    let sph = "[hair-hair]\nsmoothing_length = 0.01\nrest_density = 100.0\nstiffness = 1.0\nviscosity = 0.1\n";
-    refused(
-        &[("[\"gravity\"]", "[\"gravity\", \"hair-hair\"]")],
-        sph,
-        "t.toml:6: effects[1]: \"hair-hair\" needs the SPH stage, which is not built yet",
-    );
 }
 
 #[test]
@@ -493,8 +482,8 @@ fn hair_errors() {
     );
     refused(
         &[],
-        &file("path = \"a.obj\"\n"),
-        "t.toml:13: hair.file.path: \"a.obj\" is not a hair file, allowed a .hair or .tfx file",
+        &file("path = \"a.txt\"\n"),
+        "t.toml:13: hair.file.path: \"a.txt\" is not a hair file, allowed a .hair or .tfx file",
     );
     refused(
         &[],
@@ -506,7 +495,26 @@ fn hair_errors() {
         &file("path = \"a.hair\"\nup = \"x\"\n"),
         "t.toml:14: hair.file.up: \"x\" is not known, allowed \"y\", \"z\"",
     );
-    refused(&[], &file("path = \"a.hair\"\n"), "t.toml:13: hair.file.path: cannot load \"a.hair\": hair files arrive with the hairfile module");
+    refused(
+        &[],
+        &file("path = \"no-such-file.hair\"\n"),
+        "t.toml:13: hair.file.path: cannot read \"no-such-file.hair\":",
+    );
+    refused(
+        &[],
+        &file("path = \"a.hair\"\nnodes = 2\n"),
+        "t.toml:14: hair.file.nodes: 2 is out of range, allowed 3 to 128",
+    );
+    refused(
+        &[],
+        &file("path = \"a.hair\"\nmax_strands = 0\n"),
+        "t.toml:14: hair.file.max_strands: 0 is out of range, allowed 1 to 1000000",
+    );
+    refused(
+        &[],
+        &file("path = \"a.hair\"\nmin_length = -1.0\n"),
+        "t.toml:14: hair.file.min_length: -1 is out of range, allowed 0 to 10 m",
+    );
 }
 
 #[test]
@@ -585,28 +593,34 @@ fn grab_wind_sph_and_output_errors() {
         &five,
         "t.toml:32: grabs[4]: 5 grabs, allowed at most 4",
     );
+    let wind = "[wind]\ndirection = [1.0, 0.0, 0.0]\nstrength = 2.0\n";
     refused(
         &[],
-        "[wind]\nvelocity = [1.0, 0.0, 0.0]\ndrag = 0.0\n",
-        "t.toml:14: wind.drag: 0 is out of range, allowed > 0 and <= 0.01 kg/s",
+        "[wind]\ndirection = [0.0, 0.0, 0.0]\nstrength = 2.0\n",
+        "t.toml:13: wind.direction: [0.0, 0.0, 0.0] is not a direction",
     );
     refused(
         &[],
-        "[wind]\nvelocity = [1e3, 0.0, 0.0]\ndrag = 1e-6\n",
-        "t.toml:13: wind.velocity: [1000.0, 0.0, 0.0] is out of range",
+        "[wind]\ndirection = [1.0, 0.0, 0.0]\nstrength = -2.0\n",
+        "t.toml:14: wind.strength: -2 is out of range, allowed 0 to 1000 m/s2",
     );
     refused(
         &[],
-        "[wind]\nvelocity = [1.0, 0.0, 0.0]\ndrag = 1e-6\ngust = 2.0\n",
-        "t.toml:15: wind.gust: 2 is out of range, allowed 0 to 1",
+        &format!("{wind}gust = 20.0\n"),
+        "t.toml:15: wind.gust: 20 is out of range, allowed 0 to 10",
     );
     refused(
         &[],
-        "[wind]\nvelocity = [1.0, 0.0, 0.0]\ndrag = 1e-6\ngust_frequency = -2.0\n",
-        "t.toml:15: wind.gust_frequency: -2 is out of range, allowed 0 to 100 Hz",
+        &format!("{wind}gust_frequency = -2.0\n"),
+        "t.toml:15: wind.gust_frequency: -2 is out of range, allowed 0 to 1000 Hz",
+    );
+    refused(
+        &[],
+        &format!("{wind}seed = -1\n"),
+        "t.toml:15: wind.seed: invalid value: integer `-1`, expected u32",
     );
     let sph = |field: &str, value: &str| {
-        let mut body = "[hair-hair]\nsmoothing_length = 0.01\nrest_density = 100.0\nstiffness = 1.0\nviscosity = 0.1\n".to_string();
+        let mut body = "[hair-hair]\nsmoothing_length = 0.01\nrest_density = 100.0\nstiffness = 0.1\nviscosity = 0.1\n".to_string();
         body = if let Some(start) = body.find(&format!("{field} = ")) {
             let end = start + body[start..].find('\n').unwrap_or(0);
             format!("{}{field} = {value}{}", &body[..start], &body[end..])
@@ -618,7 +632,7 @@ fn grab_wind_sph_and_output_errors() {
     refused(
         &[],
         &sph("smoothing_length", "0.0"),
-        "t.toml:13: hair-hair.smoothing_length: 0 is out of range, allowed > 0 and <= 0.1 m",
+        "t.toml:13: hair-hair.smoothing_length: 0 is out of range, allowed 0.0001 to 1 m",
     );
     refused(
         &[],
@@ -627,13 +641,13 @@ fn grab_wind_sph_and_output_errors() {
     );
     refused(
         &[],
-        &sph("stiffness", "-1.0"),
-        "t.toml:15: hair-hair.stiffness: -1 is out of range",
+        &sph("stiffness", "0.6"),
+        "t.toml:15: hair-hair.stiffness: 0.6 is out of range, allowed 0 to 0.5 m2/s2",
     );
     refused(
         &[],
         &sph("viscosity", "1e9"),
-        "t.toml:16: hair-hair.viscosity: 1000000000 is out of range",
+        "t.toml:16: hair-hair.viscosity: 1000000000 is out of range, allowed 0 to 200",
     );
     refused(
         &[],
@@ -643,18 +657,18 @@ fn grab_wind_sph_and_output_errors() {
     refused(
         &[],
         &sph("skip_same_strand", "99"),
-        "t.toml:17: hair-hair.skip_same_strand: 99 is out of range, allowed 0 to 16",
+        "t.toml:17: hair-hair.skip_same_strand: 99 is out of range, allowed 0 to 64",
     );
     refused(
         &[],
         "[output]\nevery = 0\n",
         "t.toml:13: output.every: 0 is out of range",
     );
-    refused(&[], "[output]\nformats = [\"obj\", \"fbx\"]\n", "t.toml:13: output.formats[1]: \"fbx\" is not known, allowed \"obj\", \"ply\", \"hair\", \"usda\"");
+    refused(&[], "[output]\nformats = [\"obj\", \"fbx\"]\n", "t.toml:13: output.formats[1]: \"fbx\" is not known, allowed \"obj\", \"ply\", \"hair\", \"usda\", \"tfx\"");
     refused(
         &[],
         "[output]\npicture = \"jpeg\"\n",
-        "t.toml:13: output.picture: \"jpeg\" is not known, allowed \"png\", \"gif\", \"none\"",
+        "t.toml:13: output.picture: \"jpeg\" is not known, allowed \"png\", \"gif\"",
     );
     refused(
         &[],

@@ -255,21 +255,8 @@ pub fn check(scene: &Scene) -> Check {
         }
         None => {}
     }
-    match &scene.hair_hair {
-        Some(h) => hair_hair(h)?,
-        None if effects.contains(&Effect::HairHair) => {
-            return fail(
-                "hair-hair",
-                "missing: the effect \"hair-hair\" is on, give a [hair-hair] table",
-            );
-        }
-        None => {}
-    }
-    if let Some(i) = effects.iter().position(|e| *e == Effect::HairHair) {
-        return fail(
-            format!("effects[{i}]"),
-            "\"hair-hair\" needs the SPH stage, which is not built yet, allowed: every other effect",
-        );
+    if let Some(h) = &scene.hair_hair {
+        hair_hair(h)?;
     }
     if let Some(output) = &scene.output {
         self::output(output)?;
@@ -370,6 +357,24 @@ fn dftl(scene: &Scene) -> Check {
     }
     if let Some(v) = d.reference_dt {
         positive("dftl.reference_dt", v, 1.0, " s")?;
+    }
+    if let Some(v) = d.global_shape_fade {
+        range(
+            "dftl.global_shape_fade",
+            v,
+            0.0,
+            1.0,
+            " (1: zero at the tip)",
+        )?;
+    }
+    if let Some(v) = d.local_shape_fade {
+        range(
+            "dftl.local_shape_fade",
+            v,
+            0.0,
+            1.0,
+            " (1: zero at the tip)",
+        )?;
     }
     Ok(())
 }
@@ -657,6 +662,20 @@ fn hair(scene: &Scene) -> Check {
             if let Some(up) = &file.up {
                 one_of(&format!("{f}.up"), up, &["y", "z"])?;
             }
+            if let Some(n) = file.nodes {
+                count(&format!("{f}.nodes"), u64::from(n), 3, u64::from(MAX_NODES))?;
+            }
+            if let Some(n) = file.max_strands {
+                count(
+                    &format!("{f}.max_strands"),
+                    u64::from(n),
+                    1,
+                    u64::from(MAX_STRANDS),
+                )?;
+            }
+            if let Some(l) = file.min_length {
+                range(&format!("{f}.min_length"), l, 0.0, 10.0, " m")?;
+            }
             Ok(())
         }
     }
@@ -759,27 +778,35 @@ fn grabs(list: &[GrabSpec]) -> Check {
 }
 
 fn wind(w: &WindSpec) -> Check {
-    point("wind.velocity", w.velocity)?;
-    positive("wind.drag", w.drag, 0.01, " kg/s")?;
+    direction("wind.direction", w.direction)?;
+    range("wind.strength", w.strength, 0.0, 1000.0, " m/s2")?;
     if let Some(g) = w.gust {
-        range("wind.gust", g, 0.0, 1.0, " (fraction of the mean)")?;
+        range("wind.gust", g, 0.0, 10.0, " (fraction of strength)")?;
     }
     if let Some(f) = w.gust_frequency {
-        range("wind.gust_frequency", f, 0.0, 100.0, " Hz")?;
+        range("wind.gust_frequency", f, 0.0, 1000.0, " Hz")?;
     }
     Ok(())
 }
 
 fn hair_hair(h: &HairHairSpec) -> Check {
-    positive("hair-hair.smoothing_length", h.smoothing_length, 0.1, " m")?;
-    positive("hair-hair.rest_density", h.rest_density, 1.0e5, " kg/m3")?;
-    range("hair-hair.stiffness", h.stiffness, 0.0, 1.0e9, "")?;
-    range("hair-hair.viscosity", h.viscosity, 0.0, 1.0e3, "")?;
+    if let Some(v) = h.smoothing_length {
+        range("hair-hair.smoothing_length", v, 1.0e-4, 1.0, " m")?;
+    }
+    if let Some(v) = h.rest_density {
+        range("hair-hair.rest_density", v, 0.0, 1.0e5, " kg/m3")?;
+    }
+    if let Some(v) = h.stiffness {
+        range("hair-hair.stiffness", v, 0.0, 0.5, " m2/s2")?;
+    }
+    if let Some(v) = h.viscosity {
+        range("hair-hair.viscosity", v, 0.0, 200.0, "")?;
+    }
     if let Some(n) = h.max_neighbours {
         count("hair-hair.max_neighbours", u64::from(n), 1, 256)?;
     }
     if let Some(n) = h.skip_same_strand {
-        count("hair-hair.skip_same_strand", u64::from(n), 0, 16)?;
+        count("hair-hair.skip_same_strand", u64::from(n), 0, 64)?;
     }
     Ok(())
 }
@@ -793,12 +820,15 @@ fn output(o: &OutputSpec) -> Check {
             one_of(
                 &format!("output.formats[{i}]"),
                 name,
-                &["obj", "ply", "hair", "usda"],
+                &["obj", "ply", "hair", "usda", "tfx"],
             )?;
         }
     }
     if let Some(p) = &o.picture {
-        one_of("output.picture", p, &["png", "gif", "none"])?;
+        one_of("output.picture", p, &["png", "gif"])?;
+    }
+    if let Some(v) = &o.view {
+        one_of("output.view", v, &["front", "back", "side", "top"])?;
     }
     if let Some(w) = o.width {
         count("output.width", u64::from(w), 16, 8192)?;
