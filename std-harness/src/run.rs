@@ -414,6 +414,11 @@ fn run_n<const N: usize, M: Math>(
                 })
                 .collect()
         }),
+        sph_neighbours: sim.sph.as_ref().map(|sph| {
+            let samples = sph.stats.runs as f64 * sph.particles().max(1) as f64;
+            sph.stats.neighbours as f64 / samples.max(1.0)
+        }),
+        sph_truncated: sim.sph.as_ref().map(|sph| sph.stats.truncated),
         written: written.iter().map(|p| p.display().to_string()).collect(),
         collider_forces: (!sim.colliders.is_empty()).then(|| {
             last.collider_forces[..sim.colliders.len()]

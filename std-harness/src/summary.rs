@@ -51,6 +51,12 @@ pub struct Summary {
     /// Each grab's status after the last step: held, slipped or released (only with grabs).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grab_status: Option<Vec<String>>,
+    /// SPH neighbours per node per step, on average (only with `hair-hair`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sph_neighbours: Option<f64>,
+    /// Neighbours the SPH cap dropped, over the run (only with `hair-hair`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sph_truncated: Option<u64>,
     /// Files written by `--out` (empty without it).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub written: Vec<String>,
@@ -115,6 +121,11 @@ impl Summary {
         }
         if let Some(forces) = &self.collider_forces {
             text.push_str(&format!("\ncolliders   {}", vectors(forces)));
+        }
+        if let (Some(mean), Some(truncated)) = (self.sph_neighbours, self.sph_truncated) {
+            text.push_str(&format!(
+                "\nhair-hair   {mean:.1} neighbours per node, {truncated} dropped by the cap"
+            ));
         }
         if let Some(last) = self.written.last() {
             text.push_str(&format!(
