@@ -50,6 +50,7 @@ pub fn step_strands<M: Math, const N: usize>(
                 strand,
                 ctx,
                 grabs,
+                index,
                 strand_accelerations,
                 report,
             ),

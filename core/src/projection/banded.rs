@@ -1,0 +1,285 @@
+//! The banded LDLᵀ of the projection's matrix `A = ∇C M⁻¹ ∇Cᵀ` (Goldenthal 2007 Sec. 4: the
+//! matrix of a chain is banded, so a step costs O(n·w²)), in fixed arrays: no dense matrix,
+//! no heap.
+//!
+//! Storage is by rows of the lower band: `band[r][0]` holds `A_rr` (then the pivot `D_r`),
+//! `band[r][k]` holds `A_{r,r−k}` (then `L_{r,r−k}`), `k ≤ MAX_HALF_BANDWIDTH`. Each row `r`
+//! also has an envelope start `first[r]`: entries left of it are zero in `A` and stay zero in
+//! `L` (fill-in never leaves the envelope), so the factorisation visits only
+//! `first[r] … r` — a profile (skyline) solver inside a fixed band.
+//!
+//! A pivot that is not clearly positive (a dependent row: two collision rows with the same
+//! normal, a segment of zero length, a node held between two collinear prescribed neighbours)
+//! is *dropped*: `D_r = 0`, its column of `L` is zero and its multiplier is 0. That solves
+//! the system without that row, which is what a rank-deficient `∇C` allows; the caller
+//! counts the dropped rows.
+
+use super::constraints::{Row, RowKind, MAX_NODE_CONTACTS};
+use crate::math::Real;
+
+/// Largest half-bandwidth: 1 + the most collision rows on one node.
+pub const MAX_HALF_BANDWIDTH: usize = 1 + MAX_NODE_CONTACTS;
+
+/// One row of the lower band: `[A_rr, A_{r,r−1}, …, A_{r,r−MAX_HALF_BANDWIDTH}]`.
+pub type BandRow = [Real; MAX_HALF_BANDWIDTH + 1];
+
+/// A pivot below this fraction of its row's diagonal `A_rr` means the row depends on the rows
+/// before it (f32 keeps ~1e-7 of `A_rr` through the eliminations: 100× margin).
+pub const PIVOT_RATIO: Real = 1.0e-5;
+
+/// The envelope start of row `r`, clamped into the band so that no access can leave it.
+#[inline(always)]
+fn envelope(first: &[u16], r: usize) -> usize {
+    let f = first.get(r).map_or(r, |&f| usize::from(f));
+    f.clamp(r.saturating_sub(MAX_HALF_BANDWIDTH), r)
+}
+
+/// `A_{rc} = Σ_i w_i ∇_{x_i}C_r · ∇_{x_i}C_c` over the nodes both rows touch.
+#[inline(always)]
+fn product(a: &Row, b: &Row, inverse_mass: &[Real]) -> Real {
+    let mut sum = 0.0;
+    for (&na, ga) in a.nodes.iter().zip(a.gradient.iter()) {
+        for (&nb, gb) in b.nodes.iter().zip(b.gradient.iter()) {
+            if na == nb {
+                let w = inverse_mass.get(usize::from(na)).copied().unwrap_or(0.0);
+                sum += w * ga.dot(*gb);
+            }
+        }
+    }
+    sum
+}
+
+/// Fills `band` with the lower band of `A = ∇C M⁻¹ ∇Cᵀ` for `rows` (envelopes `first`).
+/// A padding row gets `A_rr = 1` and no coupling, so its multiplier is 0.
+pub fn assemble(rows: &[Row], first: &[u16], inverse_mass: &[Real], band: &mut [BandRow]) {
+    for (r, (row, out)) in rows.iter().zip(band.iter_mut()).enumerate() {
+        *out = [0.0; MAX_HALF_BANDWIDTH + 1];
+        if row.kind == RowKind::Padding {
+            out[0] = 1.0;
+            continue;
+        }
+        for c in envelope(first, r)..=r {
+            if let (Some(entry), Some(column)) = (out.get_mut(r - c), rows.get(c)) {
+                *entry = product(row, column, inverse_mass);
+            }
+        }
+    }
+}
+
+/// Factors `band` in place into `L D Lᵀ` (unit lower `L`). Returns how many rows were dropped
+/// at a singular or non-finite pivot. O(rows · w²).
+pub fn factor(band: &mut [BandRow], first: &[u16]) -> u32 {
+    let mut dropped = 0;
+    for r in 0..band.len() {
+        let start = envelope(first, r);
+        // L_rj = (A_rj − Σ_{p<j} L_rp D_p L_jp) / D_j, for j = start … r−1.
+        for j in start..r {
+            let inner = start.max(envelope(first, j));
+            let mut s = band[r][r - j];
+            for p in inner..j {
+                s -= band[r][r - p] * band[p][0] * band[j][j - p];
+            }
+            let d = band[j][0];
+            band[r][r - j] = if d > 0.0 { s / d } else { 0.0 };
+        }
+        // D_r = A_rr − Σ_p L_rp² D_p.
+        let diagonal = band[r][0];
+        let mut d = diagonal;
+        for p in start..r {
+            let l = band[r][r - p];
+            d -= l * l * band[p][0];
+        }
+        // `!(… > …)` also catches NaN.
+        if !(diagonal > 0.0 && d > PIVOT_RATIO * diagonal && d.is_finite()) {
+            d = 0.0;
+            dropped += 1;
+        }
+        band[r][0] = d;
+    }
+    dropped
+}
+
+/// Solves `L D Lᵀ y = b` in place (`rhs` holds `b`, then `y`); a dropped row's unknown is 0.
+pub fn solve(band: &[BandRow], first: &[u16], rhs: &mut [Real]) {
+    let count = band.len().min(rhs.len());
+    // Forward: L z = b.
+    for r in 0..count {
+        let mut s = rhs[r];
+        for p in envelope(first, r)..r {
+            s -= band[r][r - p] * rhs[p];
+        }
+        rhs[r] = s;
+    }
+    // Diagonal: D u = z.
+    for r in 0..count {
+        let d = band[r][0];
+        rhs[r] = if d > 0.0 { rhs[r] / d } else { 0.0 };
+    }
+    // Backward: Lᵀ y = u, a column of Lᵀ at a time from the last row up.
+    for r in (0..count).rev() {
+        let y = rhs[r];
+        for p in envelope(first, r)..r {
+            rhs[p] -= band[r][r - p] * y;
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)] // dense reference code reads best with indices
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec;
+    use std::vec::Vec;
+
+    /// A small deterministic generator (xorshift) for test matrices.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> f64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// Dense Gaussian elimination with partial pivoting in f64: the independent reference.
+    fn dense_solve(mut a: Vec<Vec<f64>>, mut b: Vec<f64>) -> Vec<f64> {
+        let n = b.len();
+        for k in 0..n {
+            let p = (k..n)
+                .max_by(|&i, &j| a[i][k].abs().total_cmp(&a[j][k].abs()))
+                .unwrap();
+            a.swap(k, p);
+            b.swap(k, p);
+            for i in k + 1..n {
+                let f = a[i][k] / a[k][k];
+                for j in k..n {
+                    a[i][j] -= f * a[k][j];
+                }
+                b[i] -= f * b[k];
+            }
+        }
+        let mut x = vec![0.0; n];
+        for i in (0..n).rev() {
+            let s: f64 = (i + 1..n).map(|j| a[i][j] * x[j]).sum();
+            x[i] = (b[i] - s) / a[i][i];
+        }
+        x
+    }
+
+    /// A random symmetric matrix of half-bandwidth `w`, made SPD by a diagonal that dominates
+    /// its row by a random margin (so it is not trivially diagonal).
+    fn random_spd_band(n: usize, w: usize, rng: &mut Rng) -> Vec<Vec<f64>> {
+        let mut a = vec![vec![0.0; n]; n];
+        for i in 0..n {
+            for k in 1..=w.min(i) {
+                let v = rng.next() * 2.0 - 1.0;
+                a[i][i - k] = v;
+                a[i - k][i] = v;
+            }
+        }
+        for i in 0..n {
+            // Dominant by a random margin: SPD, but not trivially diagonal.
+            let off: f64 = (0..n).filter(|&j| j != i).map(|j| a[i][j].abs()).sum();
+            a[i][i] = off * (1.0 + rng.next()) + 0.05;
+        }
+        a
+    }
+
+    #[test]
+    fn banded_solve_equals_a_dense_reference_on_random_spd_band_matrices() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut checked = 0;
+        for trial in 0..300 {
+            let n = 1 + trial % 40;
+            let w = 1 + trial % MAX_HALF_BANDWIDTH;
+            let a = random_spd_band(n, w, &mut rng);
+            // Skip the rare draw that is not positive definite (checked by the f64 pivots).
+            let b: Vec<f64> = (0..n).map(|_| rng.next() * 2.0 - 1.0).collect();
+            let reference = dense_solve(a.clone(), b.clone());
+            let mut band = vec![[0.0 as Real; MAX_HALF_BANDWIDTH + 1]; n];
+            let first: Vec<u16> = (0..n).map(|r| r.saturating_sub(w) as u16).collect();
+            for r in 0..n {
+                for c in r.saturating_sub(w)..=r {
+                    band[r][r - c] = a[r][c] as Real;
+                }
+            }
+            let dropped = factor(&mut band, &first);
+            let mut y: Vec<Real> = b.iter().map(|&v| v as Real).collect();
+            solve(&band, &first, &mut y);
+            if dropped > 0 {
+                continue;
+            }
+            let scale = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            for (got, want) in y.iter().zip(&reference) {
+                assert!(
+                    (f64::from(*got) - want).abs() <= 1e-4 * scale,
+                    "trial {trial}: n {n}, w {w}: {got} vs {want}"
+                );
+            }
+            checked += 1;
+        }
+        assert!(checked == 300, "only {checked} systems were solved");
+    }
+
+    #[test]
+    fn a_profile_envelope_gives_the_same_solution_as_the_full_band() {
+        // Tridiagonal chain with one coupling reaching back 3 (a node with two contacts).
+        let n = 12;
+        let mut rng = Rng(7);
+        let mut a = random_spd_band(n, 1, &mut rng);
+        a[7][4] = 0.3;
+        a[4][7] = 0.3;
+        a[7][7] += 1.0;
+        a[4][4] += 1.0;
+        let mut first: Vec<u16> = (0..n).map(|r| r.saturating_sub(1) as u16).collect();
+        first[7] = 4;
+        let fill = |first: &[u16]| {
+            let mut band = vec![[0.0 as Real; MAX_HALF_BANDWIDTH + 1]; n];
+            for r in 0..n {
+                for c in first[r] as usize..=r {
+                    band[r][r - c] = a[r][c] as Real;
+                }
+            }
+            band
+        };
+        let full: Vec<u16> = (0..n).map(|r| r.saturating_sub(3) as u16).collect();
+        let b: Vec<Real> = (0..n).map(|i| i as Real - 5.0).collect();
+        let (mut band_env, mut band_full) = (fill(&first), fill(&full));
+        assert_eq!(factor(&mut band_env, &first), 0);
+        assert_eq!(factor(&mut band_full, &full), 0);
+        let (mut y_env, mut y_full) = (b.clone(), b.clone());
+        solve(&band_env, &first, &mut y_env);
+        solve(&band_full, &full, &mut y_full);
+        let reference = dense_solve(a, b.iter().map(|&v| f64::from(v)).collect());
+        for ((e, f), r) in y_env.iter().zip(&y_full).zip(&reference) {
+            assert!((f64::from(*e) - r).abs() < 1e-4 && (f64::from(*f) - r).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn a_dependent_row_is_dropped_not_divided_by() {
+        // Rows 0 and 1 equal (two contacts with the same normal): A = [[1,1],[1,1]] ⊕ [2].
+        let mut band = vec![[0.0 as Real; MAX_HALF_BANDWIDTH + 1]; 3];
+        band[0][0] = 1.0;
+        band[1][0] = 1.0;
+        band[1][1] = 1.0;
+        band[2][0] = 2.0;
+        let first = [0u16, 0, 2];
+        assert_eq!(factor(&mut band, &first), 1);
+        let mut y = [3.0, 3.0, 4.0];
+        solve(&band, &first, &mut y);
+        assert!(y.iter().all(|v| v.is_finite()));
+        // The kept rows are satisfied: y0 = 3 (row 1 dropped, its multiplier 0), y2 = 2.
+        assert_eq!(y, [3.0, 0.0, 2.0]);
+        // A NaN or zero diagonal is dropped too.
+        let mut bad = vec![[0.0 as Real; MAX_HALF_BANDWIDTH + 1]; 2];
+        bad[0][0] = Real::NAN;
+        let first = [0u16, 1];
+        assert_eq!(factor(&mut bad, &first), 2);
+        let mut y = [1.0, 1.0];
+        solve(&bad, &first, &mut y);
+        assert_eq!(y, [0.0, 0.0]);
+    }
+}
