@@ -155,6 +155,26 @@ impl Default for StepReport {
     }
 }
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for StepReport {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "StepReport {{ flags: {}, iterations_max: {}, cap_hits: {}, residual: {}, dropped_rows: {}, max_stretch: {}, max_penetration: {}, contacts: {}, rolled_back: {}, grabs_slipped: {} }}",
+            self.flags,
+            self.iterations_max,
+            self.cap_hits,
+            self.residual,
+            self.dropped_rows,
+            self.max_stretch,
+            self.max_penetration,
+            self.contacts,
+            self.rolled_back,
+            self.grabs_slipped
+        )
+    }
+}
+
 impl StepReport {
     /// Counts one strand through `stage`.
     #[inline(always)]

@@ -30,6 +30,7 @@ pub const ROWS_PER_NODE: usize = MAX_NODE_CONTACTS + 1;
 
 /// What a row constrains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum RowKind {
     /// A placeholder that keeps the layout fixed (fixed-cost mode): `A_rr = 1`, `C = 0`.
     #[default]
@@ -112,6 +113,7 @@ impl<const N: usize> Nodes<N> {
 
 /// Which constraints this projection enforces, and how the layout is built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Layout {
     /// Inextensibility rows (effect `inextensibility`).
     pub inextensibility: bool,

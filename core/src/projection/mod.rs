@@ -43,6 +43,7 @@ use constraints::{ContactMemory, Layout, Nodes, RowKind, Rows, MAX_NODE_CONTACTS
 
 /// What one projection did, besides what it adds to the report.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Outcome {
     /// Iterations run (solves), at most the cap.
     pub iterations: u32,
