@@ -257,7 +257,8 @@ fn surface<M: Math>(shape: &Shape, p: Vec3) -> (Vec3, Real) {
 }
 
 /// Evaluates every constraint at the positions `x` (re-detecting contacts) and lays the rows
-/// out in band order. `colliders` holds `None` for a collider to skip.
+/// out in band order. `colliders` are the step's valid colliders with their index in the
+/// step's list.
 ///
 /// `memory.touched[i]` has bit `c` set once node `i` got a row for collider `c` in this
 /// projection; such a contact keeps its row even when the node is outside, as long as its
@@ -270,7 +271,7 @@ fn surface<M: Math>(shape: &Shape, p: Vec3) -> (Vec3, Real) {
 pub fn evaluate<M: Math, const N: usize>(
     strand: &Strand<N>,
     nodes: &Nodes<N>,
-    colliders: &[Option<Shape>],
+    colliders: &[(u8, Shape)],
     layout: Layout,
     tolerance: Real,
     memory: &mut ContactMemory<N>,
@@ -292,17 +293,13 @@ pub fn evaluate<M: Math, const N: usize>(
         let envelope = previous_segment.unwrap_or(node_start);
         if layout.contact_slots > 0 && nodes.is_free(i) {
             let mut slots = 0;
-            for (c, shape) in colliders.iter().enumerate() {
-                let Some(shape) = shape else {
-                    continue;
-                };
+            for &(c, ref shape) in colliders {
                 let bit = 1u8 << (c % 8);
-                let pushing = memory
-                    .multipliers
-                    .get(i)
-                    .and_then(|m| m.get(c))
-                    .is_some_and(|&lambda| lambda < 0.0);
-                let sticky = memory.touched[i] & bit != 0 && pushing;
+                // Test the bit first: most nodes never touch anything.
+                let sticky = memory.touched[i] & bit != 0
+                    && memory.multipliers[i]
+                        .get(usize::from(c))
+                        .is_some_and(|&lambda| lambda < 0.0);
                 let contact = if sticky {
                     Some(surface::<M>(shape, x[i]))
                 } else {
@@ -316,15 +313,20 @@ pub fn evaluate<M: Math, const N: usize>(
                     let scale = rest_length[i.saturating_sub(1)];
                     rows.residual = rows.residual.max(depth / scale);
                     rows.max_depth = rows.max_depth.max(depth);
-                    let reach = match *shape {
-                        Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
-                        Shape::Plane { point, .. } => magnitude(point),
-                    };
-                    let floor = resolution_floor(RowKind::Contact(0), x[i], x[i], reach);
-                    rows.converged &= depth <= tolerance * scale + floor;
+                    if rows.converged && depth > tolerance * scale {
+                        let reach = match *shape {
+                            Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
+                            Shape::Plane { point, .. } => magnitude(point),
+                        };
+                        let kind = RowKind::Contact(c);
+                        rows.converged = depth <= resolution_floor(kind, x[i], x[i], reach);
+                    }
                 }
                 if slots < layout.contact_slots {
-                    rows.push(Row::contact(i, c, shape, normal, depth), envelope);
+                    rows.push(
+                        Row::contact(i, usize::from(c), shape, normal, depth),
+                        envelope,
+                    );
                     memory.touched[i] |= bit;
                     slots += 1;
                 } else {
@@ -354,8 +356,11 @@ pub fn evaluate<M: Math, const N: usize>(
             if relative.is_nan() || relative > rows.residual {
                 rows.residual = relative;
             }
-            let floor = resolution_floor(RowKind::Segment, x[i], x[i + 1], 0.0);
-            rows.converged &= row.value.abs() <= tolerance * rest2 + floor;
+            // The resolution floor only matters while every row so far is met.
+            if rows.converged && row.value.abs() > tolerance * rest2 {
+                let floor = resolution_floor(RowKind::Segment, x[i], x[i + 1], 0.0);
+                rows.converged = row.value.abs() <= floor;
+            }
             previous_segment = rows.push(row, envelope);
         } else {
             // Both ends prescribed (segment 0, or a grab next to the root or to another grab):

@@ -111,21 +111,18 @@ pub fn project_constraints<M: Math, const N: usize>(
     let held = grabbed_nodes(ctx, grabs, strand_index, n);
     let mut work = Workspace::new(strand, n);
     prescribe_grabs(strand, grabs, &held, &mut work.nodes);
-    let mut shapes: [Option<Shape>; MAX_COLLIDERS] = [None; MAX_COLLIDERS];
-    for (slot, shape) in shapes.iter_mut().zip(ctx.colliders()) {
-        // A collider that fails its checks (possible through `step_strands`) is skipped.
-        *slot = shape.is_valid().then_some(*shape);
-    }
+    let (shapes, shape_count) = usable_colliders(ctx);
     let layout = Layout {
         inextensibility,
         contact_slots: if collisions {
-            ctx.collider_count.min(MAX_NODE_CONTACTS)
+            shape_count.min(MAX_NODE_CONTACTS)
         } else {
             0
         },
         fixed_cost: ctx.params.mode == Mode::FixedCost,
     };
-    let outcome = iterate::<M, N>(strand, ctx, &shapes, layout, &held, &mut work);
+    let shapes = shapes.get(..shape_count).unwrap_or(&[]);
+    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
     report.ran(Stage::Velocity);
     update_velocities(strand, &work.predicted, ctx.inv_dt);
     record::<M, N>(strand, ctx, &outcome, &work, report);
@@ -166,6 +163,25 @@ impl<const N: usize> Workspace<N> {
     }
 }
 
+/// The step's colliders that pass their checks (a bad one can come through `step_strands`),
+/// each with its index in the step's list, packed at the front.
+fn usable_colliders(ctx: &StepContext) -> ([(u8, Shape); MAX_COLLIDERS], usize) {
+    let placeholder = Shape::Plane {
+        point: Vec3::ZERO,
+        normal: Vec3::Y,
+    };
+    let mut shapes = [(0, placeholder); MAX_COLLIDERS];
+    let mut count = 0;
+    for (c, shape) in ctx.colliders().iter().enumerate().take(MAX_COLLIDERS) {
+        if let (true, Some(slot)) = (shape.is_valid(), shapes.get_mut(count)) {
+            // `c < MAX_COLLIDERS = 8`: fits a u8 and the per-node contact bit mask.
+            *slot = (c as u8, *shape);
+            count += 1;
+        }
+    }
+    (shapes, count)
+}
+
 /// Grabbed nodes are prescribed: moved to their targets, infinite mass, no rows.
 fn prescribe_grabs<const N: usize>(
     strand: &mut Strand<N>,
@@ -190,7 +206,7 @@ fn prescribe_grabs<const N: usize>(
 fn iterate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    shapes: &[Option<Shape>],
+    shapes: &[(u8, Shape)],
     layout: Layout,
     held: &GrabbedNodes,
     work: &mut Workspace<N>,
