@@ -2,6 +2,10 @@
 //! matrix of a chain is banded, so a step costs O(n·w²)), in fixed arrays: no dense matrix,
 //! no heap.
 //!
+//! Collision rows come first: each touches one node, so its pivot, taken before the
+//! segments', only updates the segment entries of that node, which are in the band already
+//! ([`eliminate_contacts`]). What is left is tridiagonal whatever the contacts.
+//!
 //! Storage is by rows of the lower band: `band[r][0]` holds `A_rr` (then the pivot `D_r`),
 //! `band[r][k]` holds `A_{r,r−k}` (then `L_{r,r−k}`), `k ≤ MAX_HALF_BANDWIDTH`. Each row `r`
 //! also has an envelope start `first[r]`: entries left of it are zero in `A` and stay zero in
@@ -14,11 +18,14 @@
 //! the system without that row, which is what a rank-deficient `∇C` allows; the caller
 //! counts the dropped rows.
 
-use super::constraints::{Row, RowKind, MAX_NODE_CONTACTS};
-use crate::math::Real;
+use super::constraints::{NodeContacts, Row, RowKind, Rows, NO_ROW};
+use crate::math::{Real, Vec3};
 
-/// Largest half-bandwidth: 1 + the most collision rows on one node.
-pub const MAX_HALF_BANDWIDTH: usize = 1 + MAX_NODE_CONTACTS;
+/// Largest half-bandwidth the solver takes. The projection's segment rows need 1 (collision
+/// rows are eliminated at their node first, see [`eliminate_contacts`]); the room up to 3
+/// keeps the solver general (DESIGN.md's layouts with a node's rows in the band: a
+/// finite-mass pin has three) and is what its tests exercise.
+pub const MAX_HALF_BANDWIDTH: usize = 3;
 
 /// One row of the lower band: `[A_rr, A_{r,r−1}, …, A_{r,r−MAX_HALF_BANDWIDTH}]`.
 pub type BandRow = [Real; MAX_HALF_BANDWIDTH + 1];
@@ -34,12 +41,13 @@ fn envelope(first: &[u16], r: usize) -> usize {
     f.clamp(r.saturating_sub(MAX_HALF_BANDWIDTH), r)
 }
 
-/// `A_{rc} = Σ_i w_i ∇_{x_i}C_r · ∇_{x_i}C_c` over the nodes both rows touch.
+/// `A_{rc} = Σ_i w_i h_r^i · h_c^i` over the nodes both rows touch, with `h = (I − P_i)∇C`
+/// the gradient blocks after the elimination of the nodes' collision rows.
 #[inline(always)]
 fn product(a: &Row, b: &Row, inverse_mass: &[Real]) -> Real {
     let mut sum = 0.0;
-    for (&na, ga) in a.nodes.iter().zip(a.gradient.iter()) {
-        for (&nb, gb) in b.nodes.iter().zip(b.gradient.iter()) {
+    for (&na, ga) in a.nodes.iter().zip(a.projected.iter()) {
+        for (&nb, gb) in b.nodes.iter().zip(b.projected.iter()) {
             if na == nb {
                 let w = inverse_mass.get(usize::from(na)).copied().unwrap_or(0.0);
                 sum += w * ga.dot(*gb);
@@ -49,8 +57,9 @@ fn product(a: &Row, b: &Row, inverse_mass: &[Real]) -> Real {
     sum
 }
 
-/// Fills `band` with the lower band of `A = ∇C M⁻¹ ∇Cᵀ` for `rows` (envelopes `first`).
-/// A padding row gets `A_rr = 1` and no coupling, so its multiplier is 0.
+/// Fills `band` with the lower band of `A = ∇C M⁻¹ ∇Cᵀ` for `rows` (envelopes `first`), the
+/// Schur complement left by [`eliminate_contacts`]. A padding row gets `A_rr = 1` and no
+/// coupling, so its multiplier is 0.
 pub fn assemble(rows: &[Row], first: &[u16], inverse_mass: &[Real], band: &mut [BandRow]) {
     for (r, (row, out)) in rows.iter().zip(band.iter_mut()).enumerate() {
         *out = [0.0; MAX_HALF_BANDWIDTH + 1];
@@ -64,6 +73,106 @@ pub fn assemble(rows: &[Row], first: &[u16], inverse_mass: &[Real], band: &mut [
             }
         }
     }
+}
+
+/// Eliminates each node's collision rows (Gaussian elimination on their pivots first) and
+/// leaves their effect on the segment rows that share the node. With `G` the node's collision
+/// gradients (3×k, k ≤ 2) and `w` its inverse mass, the collision block is `w GᵀG`; its
+/// Schur complement on two segment rows `s`, `t` through the node is
+/// `w ∇_sCᵀ (I − P) ∇_tC` with `P = G (GᵀG)⁻¹ Gᵀ`, and their right-hand sides lose
+/// `∇_sC · d` with `d = G (GᵀG)⁻¹ C_G` (`w` cancels). So each segment block on the node is
+/// projected onto the contacts' tangent space (`Row::projected`) and `rhs −= ∇C·d`; the node
+/// later moves by `−d − w (I − P) Σ_s ∇_sC δλ_s`. A second collision row whose gradient
+/// nearly depends on the first (a pivot below [`PIVOT_RATIO`]) is dropped. Returns how many
+/// collision rows were dropped. O(contacts).
+pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u32 {
+    let mut dropped = 0;
+    for i in 0..nodes.min(N) {
+        let mut contacts = rows.contacts[i];
+        if contacts.count == 0 {
+            rows.contacts[i].kept = 0;
+            continue;
+        }
+        dropped += gram_inverse(&mut contacts);
+        let [c0, c1] = contacts.value;
+        let [inv00, inv01, inv11] = contacts.inverse_gram;
+        let (a0, a1) = (inv00 * c0 + inv01 * c1, inv01 * c0 + inv11 * c1);
+        let [g0, g1] = contacts.gradient;
+        contacts.displacement = g0 * a0 + g1 * a1;
+        rows.contacts[i] = contacts;
+        // The segments through node i: i − 1 (node i is its second) and i (its first).
+        let through = [(i.wrapping_sub(1), 1), (i, 0)];
+        for (segment, block) in through {
+            let Some(&r) = rows.segment_row.get(segment) else {
+                continue;
+            };
+            if r == NO_ROW {
+                continue;
+            }
+            if let Some(row) = rows.rows.get_mut(usize::from(r)) {
+                let g = row.gradient[block];
+                row.rhs -= g.dot(contacts.displacement);
+                row.projected[block] = g - project_onto_normals(&contacts, g);
+            }
+        }
+    }
+    dropped
+}
+
+/// Fills `contacts.inverse_gram` and `kept`; returns the rows dropped (dependent or empty).
+fn gram_inverse(contacts: &mut NodeContacts) -> u32 {
+    let [g0, g1] = contacts.gradient;
+    let a00 = g0.dot(g0);
+    contacts.inverse_gram = [0.0; 3];
+    contacts.kept = 0;
+    // `!(… > …)` also catches NaN.
+    if !(a00 > 0.0 && a00.is_finite()) {
+        contacts.value = [0.0; 2];
+        return u32::from(contacts.count);
+    }
+    contacts.kept = 1;
+    contacts.inverse_gram[0] = 1.0 / a00;
+    if contacts.count < 2 {
+        contacts.value[1] = 0.0;
+        contacts.gradient[1] = Vec3::ZERO;
+        return 0;
+    }
+    let (a01, a11) = (g0.dot(g1), g1.dot(g1));
+    let det = a00 * a11 - a01 * a01;
+    if det > PIVOT_RATIO * a00 * a11 && det.is_finite() {
+        contacts.kept = 2;
+        contacts.inverse_gram = [a11 / det, -a01 / det, a00 / det];
+        0
+    } else {
+        // Nearly the same normal twice: the first row meets both.
+        contacts.value[1] = 0.0;
+        contacts.gradient[1] = Vec3::ZERO;
+        1
+    }
+}
+
+/// `P v = G (GᵀG)⁻¹ Gᵀ v`: the part of `v` along the node's kept contact gradients.
+#[inline(always)]
+pub fn project_onto_normals(contacts: &NodeContacts, v: Vec3) -> Vec3 {
+    let [g0, g1] = contacts.gradient;
+    let (b0, b1) = (g0.dot(v), g1.dot(v));
+    let [inv00, inv01, inv11] = contacts.inverse_gram;
+    g0 * (inv00 * b0 + inv01 * b1) + g1 * (inv01 * b0 + inv11 * b1)
+}
+
+/// The collision multipliers of a node whose segments got `δλ`: with `S = Σ_s ∇_sC δλ_s`
+/// over its segments, `δλ_G = (w GᵀG)⁻¹ (C_G − w Gᵀ S) = (GᵀG)⁻¹ (C_G / w − Gᵀ S)`.
+#[must_use]
+pub fn contact_multipliers(contacts: &NodeContacts, inverse_mass: Real, pull: Vec3) -> [Real; 2] {
+    if contacts.kept == 0 || inverse_mass.is_nan() || inverse_mass <= 0.0 {
+        return [0.0; 2];
+    }
+    let [g0, g1] = contacts.gradient;
+    let [c0, c1] = contacts.value;
+    let b0 = c0 / inverse_mass - g0.dot(pull);
+    let b1 = c1 / inverse_mass - g1.dot(pull);
+    let [inv00, inv01, inv11] = contacts.inverse_gram;
+    [inv00 * b0 + inv01 * b1, inv01 * b0 + inv11 * b1]
 }
 
 /// Factors `band` in place into `L D Lᵀ` (unit lower `L`). Returns how many rows were dropped

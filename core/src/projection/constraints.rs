@@ -1,21 +1,24 @@
 //! The constraints of the fast manifold projection (Kmoch 2009 Sec. 8.1): each kind gives its
-//! value `C(x)` and its gradient row `∇C(x)`, and [`evaluate`] lays the rows out in the order
-//! that keeps `∇C M⁻¹ ∇Cᵀ` banded.
+//! value `C(x)` and its gradient `∇C(x)`, and [`evaluate`] lays them out so that
+//! `∇C M⁻¹ ∇Cᵀ` stays banded.
 //!
 //! * Inextensibility of segment `j`: `C = e^j·e^j − ê^j·ê^j`, `∇_{x_{j+1}}C = 2e^jᵀ = −∇_{x_j}C`.
 //! * Collision of node `i` with a sphere or capsule: `C = |x_i − c|² − r²`, `∇C = 2(x_i − c)ᵀ`
 //!   (`c` the centre, or the closest point of the capsule's axis; the row uses the secant
-//!   slope `(|x_i − c| + r) n`, equal to it on the surface — see [`Row::contact`]); with a plane:
+//!   slope `(|x_i − c| + r) n`, equal to it on the surface — see [`contact`]); with a plane:
 //!   `C = (x_i − p)·n`, `∇C = nᵀ`. Only for nodes found inside, re-detected at every iterate.
 //! * Root coupling and grabs have no rows: their nodes are prescribed (`w = 0`). A row on a
 //!   node of infinite mass is a zero row and makes the matrix singular, so prescribed nodes
 //!   never carry a collision row, and a segment between two prescribed nodes has no row.
 //!
-//! Row order per strand: `[contacts of node 0], C_0, [contacts of node 1], C_1, …`, so the
-//! half-bandwidth is 1 + the most contacts on one node. Each row also records the first
-//! column of its envelope (the earliest row it shares a node with): in converge mode the
-//! factorisation only visits that envelope, so a node without contact costs what a
-//! tridiagonal row costs and collisions cost in proportion to the contacts.
+//! Ordered `[contacts of node 0], C_0, [contacts of node 1], C_1, …` the half-bandwidth is
+//! 1 + the most contacts on one node. A collision row touches one node only, so eliminating
+//! it first (its LDLᵀ pivot taken before the segments') fills nothing outside the segments'
+//! tridiagonal band: the segments that share the node see it as a node whose inverse mass is
+//! projected onto the contact's tangent space ([`super::banded::eliminate_contacts`]). So the
+//! segment rows are kept in band order with their envelopes, and each node keeps its
+//! collision rows beside it ([`NodeContacts`]); collisions then cost in proportion to the
+//! contacts and never widen the band.
 
 use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::math::{Math, Real, Vec3};
@@ -25,8 +28,8 @@ use crate::strand::Strand;
 /// collider order) are left out that iteration and flagged.
 pub const MAX_NODE_CONTACTS: usize = 2;
 
-/// Rows a node owns in the layout: its contacts and the segment that starts at it.
-pub const ROWS_PER_NODE: usize = MAX_NODE_CONTACTS + 1;
+/// "No row" in [`Rows::segment_row`].
+pub const NO_ROW: u16 = u16::MAX;
 
 /// What a row constrains.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -35,21 +38,25 @@ pub enum RowKind {
     /// A placeholder that keeps the layout fixed (fixed-cost mode): `A_rr = 1`, `C = 0`.
     #[default]
     Padding,
-    /// Inextensibility of the segment starting at `nodes[0]`.
+    /// Inextensibility of the segment from `nodes[0]` to `nodes[1]`.
     Segment,
-    /// Contact of `nodes[0]` with the collider of this index.
-    Contact(u8),
 }
 
-/// One constraint row: its value and its gradient, which has at most two non-zero 3-blocks.
+/// One segment row: its value and gradient (two 3-blocks), and the same after the collision
+/// rows of its nodes were eliminated.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Row {
     /// `C(x_k)`.
     pub value: Real,
-    /// The nodes the two gradient blocks belong to (the same node twice for a one-node row).
+    /// The right-hand side after eliminating collision rows: `C − Σ_i ∇_{x_i}C · d_i`.
+    pub rhs: Real,
+    /// The two nodes of the segment.
     pub nodes: [u16; 2],
-    /// `∇_{x_{nodes[0]}} C` and `∇_{x_{nodes[1]}} C` (the second is zero for a one-node row).
+    /// `∇_{x_{nodes[0]}} C` and `∇_{x_{nodes[1]}} C`.
     pub gradient: [Vec3; 2],
+    /// The gradient blocks with each node's contact normals projected out, `(I − P_i)∇C`
+    /// (equal to `gradient` at a node without contact).
+    pub projected: [Vec3; 2],
     /// What the row constrains.
     pub kind: RowKind,
 }
@@ -59,35 +66,70 @@ impl Row {
     #[must_use]
     pub fn segment(j: usize, x_j: Vec3, x_next: Vec3, rest_length: Real) -> Row {
         let e = x_next - x_j;
+        let value = e.dot(e) - rest_length * rest_length;
+        let gradient = [e * -2.0, e * 2.0];
         Row {
-            value: e.dot(e) - rest_length * rest_length,
+            value,
+            rhs: value,
             nodes: [j as u16, (j + 1) as u16],
-            gradient: [e * -2.0, e * 2.0],
+            gradient,
+            projected: gradient,
             kind: RowKind::Segment,
         }
     }
+}
 
-    /// Contact of node `i` found `depth` inside `shape` with outward `normal`.
-    #[must_use]
-    pub fn contact(i: usize, collider: usize, shape: &Shape, normal: Vec3, depth: Real) -> Row {
-        let (value, gradient) = match *shape {
-            Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => {
-                // d = |x − c| = r − depth; C = d² − r² = −depth (d + r). The gradient 2(x − c)
-                // = 2d·n would send a Newton step to (d² + r²)/(2d) from the centre: five
-                // radii out from d = r/10, infinitely far from d = 0. The secant slope
-                // (d + r)·n between the node and its surface point lands the step on the
-                // surface for any depth (the centre included) and equals 2(x − c) there, at
-                // the solution.
-                let distance = radius - depth;
-                (-depth * (distance + radius), normal * (distance + radius))
+/// Value and gradient of the collision row of a node found `depth` inside `shape` (negative
+/// when outside: a contact kept from an earlier iterate) with outward `normal`.
+#[must_use]
+pub fn contact(shape: &Shape, normal: Vec3, depth: Real) -> (Real, Vec3) {
+    match *shape {
+        Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => {
+            // d = |x − c| = r − depth; C = d² − r² = −depth (d + r). The gradient 2(x − c) =
+            // 2d·n would send a Newton step to (d² + r²)/(2d) from the centre: five radii out
+            // from d = r/10, infinitely far from d = 0. The secant slope (d + r)·n between
+            // the node and its surface point lands the step on the surface for any depth
+            // (the centre included) and equals 2(x − c) there, at the solution.
+            let distance = radius - depth;
+            (-depth * (distance + radius), normal * (distance + radius))
+        }
+        Shape::Plane { .. } => (-depth, normal),
+    }
+}
+
+/// The collision rows of one node, and what eliminating them leaves for the segments.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeContacts {
+    /// Rows in use (≤ [`MAX_NODE_CONTACTS`]).
+    pub count: u8,
+    /// The collider of each row (its index in the step's list).
+    pub collider: [u8; MAX_NODE_CONTACTS],
+    /// `C` of each row.
+    pub value: [Real; MAX_NODE_CONTACTS],
+    /// `∇_{x_i}C` of each row.
+    pub gradient: [Vec3; MAX_NODE_CONTACTS],
+    /// Rows kept by the elimination (a row whose gradient depends on the first is dropped).
+    pub kept: u8,
+    /// `(GᵀG)⁻¹` of the kept gradients `G`, as `[a₀₀, a₀₁, a₁₁]`.
+    pub inverse_gram: [Real; 3],
+    /// `d = G (GᵀG)⁻¹ C`: minus the smallest move that meets the linearised contacts.
+    pub displacement: Vec3,
+}
+
+impl NodeContacts {
+    fn push(&mut self, collider: u8, value: Real, gradient: Vec3) -> bool {
+        let k = usize::from(self.count);
+        match (
+            self.collider.get_mut(k),
+            self.value.get_mut(k),
+            self.gradient.get_mut(k),
+        ) {
+            (Some(c), Some(v), Some(g)) => {
+                (*c, *v, *g) = (collider, value, gradient);
+                self.count += 1;
+                true
             }
-            Shape::Plane { .. } => (-depth, normal),
-        };
-        Row {
-            value,
-            nodes: [i as u16, i as u16],
-            gradient: [gradient, Vec3::ZERO],
-            kind: RowKind::Contact(collider as u8),
+            _ => false,
         }
     }
 }
@@ -117,22 +159,28 @@ impl<const N: usize> Nodes<N> {
 pub struct Layout {
     /// Inextensibility rows (effect `inextensibility`).
     pub inextensibility: bool,
-    /// Collision slots per free node: 0 when `collisions` is off or there is no collider.
+    /// Collision rows per free node at most: 0 when `collisions` is off or there is no
+    /// collider.
     pub contact_slots: usize,
-    /// Fixed cost: every slot gets a row (padding where nothing is in contact) and every row
-    /// the full band, so the work does not depend on the state.
+    /// Fixed cost: a row for every segment that may carry one (padding where it cannot) and
+    /// the full band for every row, so the work does not depend on the state.
     pub fixed_cost: bool,
 }
 
-/// The rows at one iterate, flattened as `rows[r / ROWS_PER_NODE][r % ROWS_PER_NODE]`.
+/// The constraints at one iterate: segment rows in band order, collision rows by node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rows<const N: usize> {
-    /// The rows, in band order.
-    pub rows: [[Row; ROWS_PER_NODE]; N],
-    /// First column of each row's envelope (`first[r] ≤ r`, `r − first[r] ≤ 1 + MAX_NODE_CONTACTS`).
-    pub first: [[u16; ROWS_PER_NODE]; N],
+    /// The segment rows, in band order (`count` in use).
+    pub rows: [Row; N],
+    /// First column of each row's envelope (`first[r] ≤ r`): the previous row when it shares
+    /// a node with this one.
+    pub first: [u16; N],
     /// Rows in use.
     pub count: usize,
+    /// Row index of segment `j`, or [`NO_ROW`].
+    pub segment_row: [u16; N],
+    /// Each node's collision rows.
+    pub contacts: [NodeContacts; N],
     /// `max_j |C_j| / (ê^j·ê^j)` over segment rows and `depth / |ê^{i−1}|` over nodes inside a
     /// collider (with or without a row): the relative residual at this iterate.
     pub residual: Real,
@@ -148,9 +196,11 @@ pub struct Rows<const N: usize> {
 impl<const N: usize> Default for Rows<N> {
     fn default() -> Self {
         Rows {
-            rows: [[Row::default(); ROWS_PER_NODE]; N],
-            first: [[0; ROWS_PER_NODE]; N],
+            rows: [Row::default(); N],
+            first: [0; N],
             count: 0,
+            segment_row: [NO_ROW; N],
+            contacts: [NodeContacts::default(); N],
             residual: 0.0,
             converged: true,
             max_depth: 0.0,
@@ -160,24 +210,22 @@ impl<const N: usize> Default for Rows<N> {
 }
 
 impl<const N: usize> Rows<N> {
-    /// The rows in use, flattened.
+    /// The rows in use.
     #[must_use]
     pub fn rows(&self) -> &[Row] {
-        self.rows.as_flattened().get(..self.count).unwrap_or(&[])
+        self.rows.get(..self.count).unwrap_or(&[])
     }
 
     /// The envelope starts of the rows in use.
     #[must_use]
     pub fn first(&self) -> &[u16] {
-        self.first.as_flattened().get(..self.count).unwrap_or(&[])
+        self.first.get(..self.count).unwrap_or(&[])
     }
 
     fn push(&mut self, row: Row, first: usize) -> Option<usize> {
         let r = self.count;
-        let slot = self.rows.as_flattened_mut().get_mut(r)?;
-        *slot = row;
-        let start = self.first.as_flattened_mut().get_mut(r)?;
-        *start = first.min(r) as u16;
+        *self.rows.get_mut(r)? = row;
+        *self.first.get_mut(r)? = first.min(r) as u16;
         self.count += 1;
         Some(r)
     }
@@ -214,16 +262,14 @@ fn magnitude(p: Vec3) -> Real {
 /// default tolerance 1e-6, which Newton steps then cannot reach (they stall at the rounding).
 /// Rows within this floor count as satisfied; the reported residual stays the true value.
 #[must_use]
-pub fn resolution_floor(row_kind: RowKind, a: Vec3, b: Vec3, length_scale: Real) -> Real {
+pub fn resolution_floor(is_contact: bool, a: Vec3, b: Vec3, length_scale: Real) -> Real {
     let eps = Real::EPSILON;
     let m = magnitude(a).max(magnitude(b));
-    match row_kind {
-        RowKind::Segment => {
-            let e = b - a;
-            2.0 * eps * (e.x.abs() + e.y.abs() + e.z.abs()) * m + eps * e.dot(e)
-        }
-        RowKind::Contact(_) => 2.0 * eps * (m + length_scale),
-        RowKind::Padding => 0.0,
+    if is_contact {
+        2.0 * eps * (m + length_scale)
+    } else {
+        let e = b - a;
+        2.0 * eps * (e.x.abs() + e.y.abs() + e.z.abs()) * m + eps * e.dot(e)
     }
 }
 
@@ -257,16 +303,15 @@ fn surface<M: Math>(shape: &Shape, p: Vec3) -> (Vec3, Real) {
 }
 
 /// Evaluates every constraint at the positions `x` (re-detecting contacts) and lays the rows
-/// out in band order. `colliders` are the step's valid colliders with their index in the
-/// step's list.
+/// out. `colliders` are the step's valid colliders with their index in the step's list.
 ///
 /// `memory.touched[i]` has bit `c` set once node `i` got a row for collider `c` in this
 /// projection; such a contact keeps its row even when the node is outside, as long as its
-/// accumulated multiplier `memory.multipliers[i][c]` pushes (`Λ < 0`: the row moves the node along
-/// `−∇C·Λ`, outward). Dropping a row as soon as a step lands its node on the surface lets the
-/// next step, blind to the collider, push the node back through it: the contact set then
-/// flickers and the iteration does not settle. Keeping a row that pulls would glue the node
-/// to the surface, which can be infeasible with the segment lengths (a node held at the
+/// accumulated multiplier `memory.multipliers[i][c]` pushes (`Λ < 0`: the row moves the node
+/// along `−∇C·Λ`, outward). Dropping a row as soon as a step lands its node on the surface
+/// lets the next step, blind to the collider, push the node back through it: the contact set
+/// then flickers and the iteration does not settle. Keeping a row that pulls would glue the
+/// node to the surface, which can be infeasible with the segment lengths (a node held at the
 /// surface out of reach of the root).
 pub fn evaluate<M: Math, const N: usize>(
     strand: &Strand<N>,
@@ -285,14 +330,13 @@ pub fn evaluate<M: Math, const N: usize>(
     let x = &strand.state.position;
     let rest_length = &strand.rest.segment_length;
     let count = nodes.count.min(N);
-    // Row index of the previous segment's row, the earliest row the next rows can share a
-    // node with.
     let mut previous_segment: Option<usize> = None;
     for i in 0..count {
-        let node_start = rows.count;
-        let envelope = previous_segment.unwrap_or(node_start);
+        rows.contacts[i].count = 0;
+        rows.segment_row[i] = NO_ROW;
         if layout.contact_slots > 0 && nodes.is_free(i) {
-            let mut slots = 0;
+            // Node i ≥ 2 when free, so the segment before it exists.
+            let scale = rest_length[i.saturating_sub(1)];
             for &(c, ref shape) in colliders {
                 let bit = 1u8 << (c % 8);
                 // Test the bit first: most nodes never touch anything.
@@ -300,17 +344,15 @@ pub fn evaluate<M: Math, const N: usize>(
                     && memory.multipliers[i]
                         .get(usize::from(c))
                         .is_some_and(|&lambda| lambda < 0.0);
-                let contact = if sticky {
+                let found = if sticky {
                     Some(surface::<M>(shape, x[i]))
                 } else {
                     shape.penetration::<M>(x[i]).map(|c| (c.normal, c.depth))
                 };
-                let Some((normal, depth)) = contact else {
+                let Some((normal, depth)) = found else {
                     continue;
                 };
                 if depth > 0.0 {
-                    // Node i ≥ 2 when free, so the segment before it exists.
-                    let scale = rest_length[i.saturating_sub(1)];
                     rows.residual = rows.residual.max(depth / scale);
                     rows.max_depth = rows.max_depth.max(depth);
                     if rows.converged && depth > tolerance * scale {
@@ -318,31 +360,16 @@ pub fn evaluate<M: Math, const N: usize>(
                             Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
                             Shape::Plane { point, .. } => magnitude(point),
                         };
-                        let kind = RowKind::Contact(c);
-                        rows.converged = depth <= resolution_floor(kind, x[i], x[i], reach);
+                        rows.converged = depth <= resolution_floor(true, x[i], x[i], reach);
                     }
                 }
-                if slots < layout.contact_slots {
-                    rows.push(
-                        Row::contact(i, usize::from(c), shape, normal, depth),
-                        envelope,
-                    );
+                let (value, gradient) = contact(shape, normal, depth);
+                let room = usize::from(rows.contacts[i].count) < layout.contact_slots;
+                if room && rows.contacts[i].push(c, value, gradient) {
                     memory.touched[i] |= bit;
-                    slots += 1;
                 } else {
                     rows.truncated = true;
                 }
-            }
-            if layout.fixed_cost {
-                for _ in slots..layout.contact_slots {
-                    rows.push(Row::default(), node_start);
-                }
-            }
-        } else if layout.fixed_cost && i >= 2 {
-            // A prescribed node (a grab) keeps its slots so the layout does not depend on
-            // which grabs hold.
-            for _ in 0..layout.contact_slots {
-                rows.push(Row::default(), node_start);
             }
         }
         if i + 1 >= count || !layout.inextensibility {
@@ -358,14 +385,19 @@ pub fn evaluate<M: Math, const N: usize>(
             }
             // The resolution floor only matters while every row so far is met.
             if rows.converged && row.value.abs() > tolerance * rest2 {
-                let floor = resolution_floor(RowKind::Segment, x[i], x[i + 1], 0.0);
+                let floor = resolution_floor(false, x[i], x[i + 1], 0.0);
                 rows.converged = row.value.abs() <= floor;
             }
-            previous_segment = rows.push(row, envelope);
+            let first = previous_segment.unwrap_or(rows.count);
+            previous_segment = rows.push(row, first);
+            if let Some(r) = previous_segment {
+                rows.segment_row[i] = r as u16;
+            }
         } else {
             // Both ends prescribed (segment 0, or a grab next to the root or to another grab):
-            // nothing can move, so no row. Fixed cost keeps a padding row (segment 0 is always
-            // prescribed and needs none).
+            // nothing can move, so no row. Fixed cost keeps a padding row in its place
+            // (segment 0 is always prescribed and needs none), so that the row count does
+            // not depend on which grabs hold.
             if layout.fixed_cost && i >= 1 {
                 rows.push(Row::default(), rows.count);
             }
@@ -373,17 +405,9 @@ pub fn evaluate<M: Math, const N: usize>(
         }
     }
     if layout.fixed_cost {
-        // The worst-case band for every row: the work of the factorisation is the same
-        // whatever the contacts.
-        let band = 1 + layout.contact_slots;
-        for (r, first) in rows
-            .first
-            .as_flattened_mut()
-            .iter_mut()
-            .enumerate()
-            .take(rows.count)
-        {
-            *first = r.saturating_sub(band) as u16;
+        // The full band for every row: the factorisation's work is the same whatever holds.
+        for (r, first) in rows.first.iter_mut().enumerate().take(rows.count) {
+            *first = r.saturating_sub(1) as u16;
         }
     }
 }

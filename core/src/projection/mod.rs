@@ -8,7 +8,9 @@
 //!    pushed in by the projection is caught in the same step) — [`constraints`];
 //! 2. stop if `max_j |C_j| / (ê^j·ê^j) ≤ tol` (converge mode only; a row within what f32
 //!    positions can resolve counts as met — see [`constraints::resolution_floor`]);
-//! 3. solve `(∇C M⁻¹ ∇Cᵀ) δλ = C(x_k)` with a banded LDLᵀ — [`banded`];
+//! 3. solve `(∇C M⁻¹ ∇Cᵀ) δλ = C(x_k)` with a banded LDLᵀ — [`banded`]: each node's collision
+//!    rows are eliminated first at their node (no fill), leaving the segments' tridiagonal
+//!    band, so contacts cost O(contacts) and never widen the band;
 //! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`.
 //!
 //! Root coupling and grabs are *prescribed* nodes (`w = 0`, no rows): nodes 0 and 1 were set
@@ -39,7 +41,7 @@ use crate::report::{Flags, Stage, StepReport};
 use crate::strand::Strand;
 
 use banded::BandRow;
-use constraints::{ContactMemory, Layout, Nodes, RowKind, Rows, MAX_NODE_CONTACTS, ROWS_PER_NODE};
+use constraints::{ContactMemory, Layout, Nodes, Rows, MAX_NODE_CONTACTS};
 
 /// What one projection did, besides what it adds to the report.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -63,8 +65,8 @@ struct Workspace<const N: usize> {
     /// Which colliders each node touched, and the contact multipliers' sums.
     contacts: ContactMemory<N>,
     rows: Rows<N>,
-    band: [[BandRow; ROWS_PER_NODE]; N],
-    multipliers: [[Real; ROWS_PER_NODE]; N],
+    band: [BandRow; N],
+    multipliers: [Real; N],
     /// `Σ_k −∇_{x_g}C_kᵀ δλ_k` per grab slot: the segments' pull on the grabbed node, × h².
     grab_pull: [Vec3; MAX_GRABS],
     /// `Σ_k ∇_{x_i}C_kᵀ δλ_k` over each collider's rows: the hair's push on it, × h².
@@ -76,7 +78,7 @@ struct Workspace<const N: usize> {
 struct IndexFits<const N: usize>;
 impl<const N: usize> IndexFits<N> {
     const OK: () = assert!(
-        N * ROWS_PER_NODE <= u16::MAX as usize,
+        N < u16::MAX as usize,
         "node capacity too large for the projection's u16 row indices"
     );
 }
@@ -154,8 +156,8 @@ impl<const N: usize> Workspace<N> {
             },
             contacts: ContactMemory::default(),
             rows: Rows::default(),
-            band: [[[0.0; banded::MAX_HALF_BANDWIDTH + 1]; ROWS_PER_NODE]; N],
-            multipliers: [[0.0; ROWS_PER_NODE]; N],
+            band: [[0.0; banded::MAX_HALF_BANDWIDTH + 1]; N],
+            multipliers: [0.0; N],
             grab_pull: [Vec3::ZERO; MAX_GRABS],
             collider_push: [Vec3::ZERO; MAX_COLLIDERS],
             truncated: false,
@@ -251,50 +253,86 @@ fn solve_and_move<const N: usize>(
     held: &GrabbedNodes,
     work: &mut Workspace<N>,
 ) -> Option<u32> {
+    let n = work.nodes.count.min(N);
+    let mut dropped = banded::eliminate_contacts(&mut work.rows, n);
     let rows = work.rows.rows();
     let first = work.rows.first();
     let count = rows.len();
-    let band = work.band.as_flattened_mut().get_mut(..count)?;
+    let band = work.band.get_mut(..count)?;
     banded::assemble(rows, first, &work.nodes.inverse_mass, band);
-    let dropped = banded::factor(band, first);
-    let multipliers = work.multipliers.as_flattened_mut().get_mut(..count)?;
+    dropped += banded::factor(band, first);
+    let multipliers = work.multipliers.get_mut(..count)?;
     for (lambda, row) in multipliers.iter_mut().zip(rows) {
-        *lambda = row.value;
+        *lambda = row.rhs;
     }
     banded::solve(band, first, multipliers);
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
+    // Segments: x_i −= w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact).
     let position = &mut strand.state.position;
     for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
-        for (&node, &gradient) in row.nodes.iter().zip(row.gradient.iter()) {
+        for ((&node, &gradient), &projected) in row
+            .nodes
+            .iter()
+            .zip(row.gradient.iter())
+            .zip(row.projected.iter())
+        {
             let i = usize::from(node);
             let w = work.nodes.inverse_mass.get(i).copied().unwrap_or(0.0);
             if w > 0.0 {
                 if let Some(x) = position.get_mut(i) {
-                    *x -= gradient * (w * lambda);
+                    *x -= projected * (w * lambda);
                 }
             } else if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
                 *pull -= gradient * lambda;
             }
         }
-        if let RowKind::Contact(c) = row.kind {
+    }
+    // Contacts: x_i −= d_i, and the multipliers the eliminated rows would have had.
+    for (i, x) in position.iter_mut().enumerate().take(n) {
+        let contacts = work.rows.contacts[i];
+        if contacts.kept == 0 {
+            continue;
+        }
+        let segment_pull = segment_pull_on_node(&work.rows, multipliers, i);
+        *x -= contacts.displacement;
+        let w = work.nodes.inverse_mass[i];
+        let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
+        let kept = usize::from(contacts.kept);
+        for ((&c, &gradient), &lambda) in contacts
+            .collider
+            .iter()
+            .zip(contacts.gradient.iter())
+            .zip(lambdas.iter())
+            .take(kept)
+        {
             let c = usize::from(c);
             if let Some(push) = work.collider_push.get_mut(c) {
-                *push += row.gradient[0] * lambda;
+                *push += gradient * lambda;
             }
-            let node = usize::from(row.nodes[0]);
-            if let Some(sum) = work
-                .contacts
-                .multipliers
-                .get_mut(node)
-                .and_then(|m| m.get_mut(c))
-            {
+            if let Some(sum) = work.contacts.multipliers[i].get_mut(c) {
                 *sum += lambda;
             }
         }
     }
     Some(dropped)
+}
+
+/// `Σ_s ∇_{x_i}C_s δλ_s` over the (at most two) segments through node `i`, with the gradients
+/// before the elimination.
+fn segment_pull_on_node<const N: usize>(rows: &Rows<N>, multipliers: &[Real], i: usize) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+        let r = rows
+            .segment_row
+            .get(segment)
+            .map_or(usize::MAX, |&r| usize::from(r));
+        if let (Some(row), Some(&lambda)) = (rows.rows.get(r), multipliers.get(r)) {
+            sum += row.gradient[block] * lambda;
+        }
+    }
+    sum
 }
 
 /// `v ← v + Δx/h`, `Δx = x_proj − x_pred` (Goldenthal 2007; Kmoch Sec. 8.2). Nodes 0 and 1
