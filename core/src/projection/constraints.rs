@@ -335,8 +335,6 @@ pub fn evaluate<M: Math, const N: usize>(
         rows.contacts[i].count = 0;
         rows.segment_row[i] = NO_ROW;
         if layout.contact_slots > 0 && nodes.is_free(i) {
-            // Node i ≥ 2 when free, so the segment before it exists.
-            let scale = rest_length[i.saturating_sub(1)];
             for &(c, ref shape) in colliders {
                 let bit = 1u8 << (c % 8);
                 // Test the bit first: most nodes never touch anything.
@@ -353,6 +351,8 @@ pub fn evaluate<M: Math, const N: usize>(
                     continue;
                 };
                 if depth > 0.0 {
+                    // Node i ≥ 2 when free, so the segment before it exists.
+                    let scale = rest_length[i.saturating_sub(1)];
                     rows.residual = rows.residual.max(depth / scale);
                     rows.max_depth = rows.max_depth.max(depth);
                     if rows.converged && depth > tolerance * scale {
