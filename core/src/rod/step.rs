@@ -7,17 +7,20 @@ use crate::math::{Math, Vec3};
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
-/// Steps one strand by `ctx.dt`. `accelerations` (if any) are the caller's per-node
-/// accelerations for this strand (SPH, wind), indexed by node.
+/// Steps one strand by `ctx.dt`. `strand_index` is the strand's index in the whole scene (as
+/// in [`Grab::strand`]); `accelerations` (if any) are the caller's per-node accelerations for
+/// this strand (SPH, wind), indexed by node.
 pub fn step<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    _grabs: &[Grab],
+    grabs: &[Grab],
+    strand_index: u32,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
     external_forces_and_integrate(strand, ctx, accelerations, report);
     root_coupling(strand, ctx, report);
+    crate::projection::project_constraints::<M, N>(strand, ctx, grabs, strand_index, report);
 }
 
 /// Symplectic Euler with the external forces `F = M g − ν ẋ` plus caller accelerations:
