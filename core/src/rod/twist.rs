@@ -1,0 +1,425 @@
+//! The quasistatic twist: the material angles `θ^j` of the unclamped segments, solved after
+//! each step for the new centreline (Kmoch 2009 Sec. 6; BWR08 Sec. 5).
+//!
+//! * [`hair_optimised_twist`] — Kmoch Sec. 6.2: each segment's material frame follows its
+//!   curvature binormals; one sweep root → tip, choosing among `θ`, `θ ± π` by the exact local
+//!   energies. One `atan2` and a few square roots per segment, no iteration.
+//! * [`newton_twist`] — BWR08: minimise `E` over the free `θ` with Newton's method on the
+//!   tridiagonal Hessian, Gauss–Newton when the full Hessian is not positive definite, an
+//!   iteration cap and a tolerance. The baseline of Kmoch's Table 2.
+//!
+//! Clamped segments (the root, grabbed segments) keep their `θ`, which [`ClampedFrames`] moves
+//! by the time-parallel transport of their material frame.
+
+use super::energy::{
+    bending_matrix, bending_twist_derivative, material_angles, material_curvature,
+    nearest_representative, node_bending_energy, node_twist_energy, twist_stiffness,
+    twist_twist_derivative, RodFrames, RodRest,
+};
+use super::{ClampedSegments, ElasticTerms, MAX_CLAMPED};
+use crate::frames::{angle_in_frame, material_frame, parallel_transport, unwrap_near};
+use crate::precision::{Precision, Scalar, Vector};
+
+/// Which quasistatic twist a scene uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum TwistMethod {
+    /// Kmoch 2009 Sec. 6.2: material frames follow the curvature binormals.
+    HairOptimised,
+    /// BWR08: Newton's method on the tridiagonal twist Hessian.
+    Newton,
+}
+
+impl TwistMethod {
+    /// The method's name in scene files (`"hair-optimised"`, `"newton"`).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            TwistMethod::HairOptimised => "hair-optimised",
+            TwistMethod::Newton => "newton",
+        }
+    }
+}
+
+/// `ε²` in the binormal weights `|κb|² / (|κb|² + ε²)`: binormals much shorter than
+/// `ε = 1e-4` (a turning angle of 0.1 mrad) fade out of the average instead of dropping out at a
+/// threshold, so `θ` does not jump when a node straightens.
+const BINORMAL_FADE: f32 = 1.0e-8;
+/// Below this weight neither binormal says anything: the segment continues its neighbour.
+const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
+
+/// The direction `(cos φ, sin φ)`, defined mod π, that segment `j`'s material vector `m1`
+/// takes in the hair-optimised twist: the mean of the directions of the binormals at nodes `j`
+/// and `j + 1` in the Bishop frame of segment `j` (Kmoch Sec. 6.2), averaged as lines:
+/// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
+/// doubled angle is a complex square, the half angle a square root.
+#[must_use]
+pub fn binormal_direction<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    j: usize,
+) -> Option<[P::R; 2]> {
+    let n = frames.interior();
+    let fade = P::R::of(BINORMAL_FADE);
+    let mut sum = [P::R::ZERO; 2];
+    // (κb·u^j, κb·v^j) = (−p₁, p₀) for node j (frame j = its "next") and node j + 1 ("prev").
+    let mut add = |p: [P::R; 2]| {
+        let (a, b) = (-p[1], p[0]);
+        let r2 = a * a + b * b;
+        let w = P::R::ONE / (r2 + fade);
+        sum[0] += (a * a - b * b) * w;
+        sum[1] += P::R::of(2.0) * a * b * w;
+    };
+    if j >= 1 && j <= n {
+        add(frames.bishop_curvature[j][1]);
+    }
+    if j < n {
+        add(frames.bishop_curvature[j + 1][0]);
+    }
+    let weight2 = sum[0] * sum[0] + sum[1] * sum[1];
+    let min = P::R::of(BINORMAL_MIN_WEIGHT);
+    if weight2 <= min * min || !weight2.is_finite() {
+        return None;
+    }
+    let inv = P::R::ONE / P::sqrt(weight2);
+    let (cos2, sin2) = (sum[0] * inv, sum[1] * inv);
+    let half = P::R::of(0.5);
+    Some(if cos2 >= P::R::ZERO {
+        let c = P::sqrt((P::R::ONE + cos2) * half);
+        [c, sin2 * half / c]
+    } else {
+        let s = P::sqrt((P::R::ONE - cos2) * half);
+        [sin2 * half / s, s]
+    })
+}
+
+/// The elastic energy that depends on `θ^j`: bending at nodes `j`, `j + 1` in frame `j` and
+/// twist at nodes `j`, `j + 1`, with the neighbours' current angles.
+fn local_energy<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    terms: ElasticTerms,
+    theta: &[P::R],
+    j: usize,
+    candidate: P::R,
+    cos_sin: [P::R; 2],
+) -> P::R {
+    let n = frames.interior();
+    let mut energy = P::R::ZERO;
+    if j >= 1 && j <= n {
+        energy += node_bending_energy(frames, rest, terms, j, 1, cos_sin);
+        energy += node_twist_energy(rest, terms, j, theta[j - 1], candidate);
+    }
+    if j < n {
+        energy += node_bending_energy(frames, rest, terms, j + 1, 0, cos_sin);
+        energy += node_twist_energy(rest, terms, j + 1, candidate, theta[j + 1]);
+    }
+    energy
+}
+
+/// Kmoch 2009 Sec. 6.2, the hair-optimised twist, in place on `theta` (length ≥ segments).
+///
+/// Sweep root → tip (a fixed order: determinism) over the unclamped segments, with the
+/// already-updated `θ^{j−1}`: take the binormal direction ([`binormal_direction`]) as the
+/// representative mod π nearest `θ^{j−1} + m̂_j`, then keep whichever of `θ`, `θ + π`, `θ − π`
+/// has the least local energy, evaluated exactly (the paper's closed-form criteria assume
+/// uniform `l̂` and neighbours at rest twist). `ω(θ ± π) = −ω(θ)`, so the three candidates cost
+/// one material-curvature evaluation. Without binormals the segment continues its neighbour
+/// at zero local twist, `θ^{j−1} + m̂_j`. Angles stay continuous in time: every choice is made
+/// relative to the neighbour, and `θ^0` is unwrapped against its previous value.
+pub fn hair_optimised_twist<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    clamped: &ClampedSegments,
+    terms: ElasticTerms,
+    theta: &mut [P::R],
+) {
+    let segments = frames.nodes.saturating_sub(1).min(theta.len());
+    for j in 1..segments {
+        if clamped.contains(j) {
+            continue;
+        }
+        let reference = theta[j - 1] + rest.rest_twist[j];
+        let Some(direction) = binormal_direction(frames, j) else {
+            theta[j] = reference;
+            continue;
+        };
+        let (angle, cos_sin) = nearest_representative::<P>(direction, reference);
+        let flipped = [-cos_sin[0], -cos_sin[1]];
+        let mut best = angle;
+        let mut best_energy = local_energy(frames, rest, terms, theta, j, angle, cos_sin);
+        for candidate in [angle + P::R::PI, angle - P::R::PI] {
+            let energy = local_energy(frames, rest, terms, theta, j, candidate, flipped);
+            if energy < best_energy {
+                best = candidate;
+                best_energy = energy;
+            }
+        }
+        theta[j] = best;
+    }
+}
+
+/// What a Newton twist solve did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct NewtonOutcome {
+    /// Newton iterations run.
+    pub iterations: u32,
+    /// Whether the last update was within the tolerance.
+    pub converged: bool,
+    /// Iterations that fell back to Gauss–Newton.
+    pub gauss_newton: u32,
+}
+
+/// Largest Newton update of one angle, rad: far from the minimum a step of the quadratic model
+/// can overshoot by turns; a quarter turn keeps the iteration in the basin.
+const MAX_NEWTON_STEP: f32 = core::f32::consts::FRAC_PI_2;
+
+/// BWR08's Newton twist: minimises `E` over the unclamped `θ^j` in place.
+///
+/// Bending is separable in `θ` and only twist couples neighbours, so the Hessian is
+/// tridiagonal: `H_jj = Σ_i (1/l̂_i)[(Jω)ᵀB(Jω) − ωᵀB(ω − ω̂)] + 2β/l̂_j + 2β/l̂_{j+1}`,
+/// `H_{j−1,j} = −2β/l̂_j`. Clamped segments are Dirichlet rows (an interior clamp splits the
+/// system). Far from rest `H_jj` can go negative: when the LDLᵀ of the full Hessian meets a
+/// non-positive pivot, the iteration uses Gauss–Newton (the `−ωᵀB(ω−ω̂)` term dropped, positive
+/// semi-definite plus the twist Laplacian). Stops when the largest update is `≤ tolerance` rad,
+/// unless `fixed_cost`, which always runs `iterations` (bounded latency).
+#[allow(clippy::too_many_arguments)]
+pub fn newton_twist<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    clamped: &ClampedSegments,
+    terms: ElasticTerms,
+    iterations: u16,
+    tolerance: P::R,
+    fixed_cost: bool,
+    theta: &mut [P::R],
+) -> NewtonOutcome {
+    let segments = frames.nodes.saturating_sub(1).min(theta.len());
+    let mut outcome = NewtonOutcome::default();
+    let mut gradient = [P::R::ZERO; N];
+    let mut full = [P::R::ZERO; N];
+    let mut gauss_newton = [P::R::ZERO; N];
+    let mut coupling = [P::R::ZERO; N];
+    let mut step = [P::R::ZERO; N];
+    let mut pivots = [P::R::ONE; N];
+    for _ in 0..iterations {
+        twist_newton_system(
+            frames,
+            rest,
+            clamped,
+            terms,
+            &theta[..segments],
+            &mut gradient,
+            &mut full,
+            &mut gauss_newton,
+            &mut coupling,
+        );
+        outcome.iterations += 1;
+        let rows = ..segments;
+        if !solve_tridiagonal(
+            &full[rows],
+            &coupling[rows],
+            &gradient[rows],
+            &mut pivots[rows],
+            &mut step[rows],
+        ) {
+            // Not positive definite: Gauss–Newton, positive definite whenever β > 0.
+            outcome.gauss_newton += 1;
+            for g in gauss_newton[rows].iter_mut() {
+                if *g <= P::R::ZERO || !g.is_finite() {
+                    *g = P::R::of(1.0e-30);
+                }
+            }
+            solve_tridiagonal(
+                &gauss_newton[rows],
+                &coupling[rows],
+                &gradient[rows],
+                &mut pivots[rows],
+                &mut step[rows],
+            );
+        }
+        let limit = P::R::of(MAX_NEWTON_STEP);
+        let mut largest = P::R::ZERO;
+        for (t, s) in theta.iter_mut().zip(&step[..segments]) {
+            let s = if *s > limit {
+                limit
+            } else if *s < -limit {
+                -limit
+            } else {
+                *s
+            };
+            *t -= s;
+            if s.abs() > largest {
+                largest = s.abs();
+            }
+        }
+        outcome.converged = largest <= tolerance;
+        if outcome.converged && !fixed_cost {
+            break;
+        }
+    }
+    outcome
+}
+
+/// The Newton system of the twist at `theta`: gradient `∂E/∂θ^j`, Hessian diagonal (full and
+/// Gauss–Newton) and the coupling `H_{j−1,j}` (stored at `j`). Clamped rows are identity rows
+/// with zero gradient and no coupling.
+#[allow(clippy::too_many_arguments)]
+pub fn twist_newton_system<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    clamped: &ClampedSegments,
+    terms: ElasticTerms,
+    theta: &[P::R],
+    gradient: &mut [P::R; N],
+    full: &mut [P::R; N],
+    gauss_newton: &mut [P::R; N],
+    coupling: &mut [P::R; N],
+) {
+    let n = frames.interior();
+    let two_beta = P::R::of(2.0) * twist_stiffness(rest, terms);
+    let cos_sin = material_angles::<P, N>(theta);
+    for j in 0..theta.len().min(N) {
+        coupling[j] = P::R::ZERO;
+        if clamped.contains(j) {
+            gradient[j] = P::R::ZERO;
+            full[j] = P::R::ONE;
+            gauss_newton[j] = P::R::ONE;
+            continue;
+        }
+        gradient[j] = bending_twist_derivative(frames, rest, terms, j, cos_sin[j])
+            + twist_twist_derivative(rest, terms, theta, j, n);
+        // Per node i touching segment j: (Jω)ᵀB(Jω)/l̂_i, ωᵀB(ω−ω̂)/l̂_i and 2β/l̂_i.
+        let b = bending_matrix(rest, terms, j);
+        let node = |i: usize, k: usize| {
+            let omega = material_curvature(frames.bishop_curvature[i][k], cos_sin[j]);
+            let rest_omega = rest.rest_curvature[i][k];
+            let inv_l = P::R::ONE / rest.voronoi_length[i];
+            let gn = (b[0] * omega[1] * omega[1] + b[1] * omega[0] * omega[0]) * inv_l;
+            let curvature = (b[0] * omega[0] * (omega[0] - rest_omega[0])
+                + b[1] * omega[1] * (omega[1] - rest_omega[1]))
+                * inv_l;
+            (gn + two_beta * inv_l, curvature)
+        };
+        let mut gn = P::R::ZERO;
+        let mut curvature = P::R::ZERO;
+        if j >= 1 && j <= n {
+            let (g, c) = node(j, 1);
+            gn += g;
+            curvature += c;
+            if !clamped.contains(j - 1) {
+                coupling[j] = -two_beta / rest.voronoi_length[j];
+            }
+        }
+        if j < n {
+            let (g, c) = node(j + 1, 0);
+            gn += g;
+            curvature += c;
+        }
+        gauss_newton[j] = gn;
+        full[j] = gn - curvature;
+    }
+}
+
+/// Solves the symmetric tridiagonal system `H s = g` (diagonal `diagonal`, `H_{j−1,j} =
+/// coupling[j]`) by LDLᵀ (Thomas), O(n), with `pivots` as scratch. Returns `false` at a
+/// non-positive pivot (not positive definite), with `solution` zeroed.
+pub fn solve_tridiagonal<R: Scalar>(
+    diagonal: &[R],
+    coupling: &[R],
+    rhs: &[R],
+    pivots: &mut [R],
+    solution: &mut [R],
+) -> bool {
+    let len = diagonal
+        .len()
+        .min(coupling.len())
+        .min(rhs.len())
+        .min(pivots.len())
+        .min(solution.len());
+    // Forward: pivots d_j = H_jj − H_{j−1,j}²/d_{j−1}, y_j = g_j − (H_{j−1,j}/d_{j−1}) y_{j−1}.
+    for j in 0..len {
+        let (pivot, y) = if j == 0 {
+            (diagonal[0], rhs[0])
+        } else {
+            let l = coupling[j] / pivots[j - 1];
+            (diagonal[j] - l * coupling[j], rhs[j] - l * solution[j - 1])
+        };
+        if !(pivot > R::ZERO && pivot.is_finite()) {
+            for s in solution.iter_mut().take(len) {
+                *s = R::ZERO;
+            }
+            return false;
+        }
+        pivots[j] = pivot;
+        solution[j] = y;
+    }
+    // Backward: s_j = (y_j − H_{j,j+1} s_{j+1}) / d_j.
+    for j in (0..len).rev() {
+        let mut y = solution[j];
+        if j + 1 < len {
+            y -= coupling[j + 1] * solution[j + 1];
+        }
+        solution[j] = y / pivots[j];
+    }
+    true
+}
+
+/// The material vectors `m1^c` of the clamped segments other than the root, saved before a
+/// step so that afterwards each moves by the time-parallel transport from its old tangent to
+/// its new one (DESIGN.md: `θ^c ← θ^c − ΔΨ^c`): a held segment's frame does not spin about
+/// its own axis when the strand bends around it.
+#[derive(Clone, Copy, Debug)]
+pub struct ClampedFrames<P: Precision> {
+    tangent: [P::V; MAX_CLAMPED],
+    material: [P::V; MAX_CLAMPED],
+}
+
+impl<P: Precision> ClampedFrames<P> {
+    /// The clamped segments' tangents and `m1` now.
+    #[must_use]
+    pub fn save<const N: usize>(
+        frames: &RodFrames<P, N>,
+        theta: &[P::R],
+        clamped: &ClampedSegments,
+    ) -> Self {
+        let zero = <P::V as Vector<P::R>>::ZERO;
+        let mut saved = ClampedFrames {
+            tangent: [zero; MAX_CLAMPED],
+            material: [zero; MAX_CLAMPED],
+        };
+        for (slot, c) in clamped.others().enumerate().take(MAX_CLAMPED) {
+            if let (Some(&t), Some(&angle)) = (frames.tangent.get(c), theta.get(c)) {
+                let (s, co) = P::sin_cos(angle);
+                saved.tangent[slot] = t;
+                saved.material[slot] =
+                    material_frame::<P>(frames.bishop_u[c], frames.bishop_v[c], [co, s]).0;
+            }
+        }
+        saved
+    }
+
+    /// Sets `θ^c` of each clamped segment to its transported `m1` measured in the new Bishop
+    /// frame, continuous with the old angle.
+    pub fn transport<const N: usize>(
+        &self,
+        frames: &RodFrames<P, N>,
+        clamped: &ClampedSegments,
+        theta: &mut [P::R],
+    ) {
+        let segments = frames.nodes.saturating_sub(1);
+        for (slot, c) in clamped.others().enumerate().take(MAX_CLAMPED) {
+            if c >= segments {
+                continue;
+            }
+            if let Some(angle) = theta.get_mut(c) {
+                let m1 = parallel_transport::<P>(
+                    self.tangent[slot],
+                    frames.tangent[c],
+                    self.material[slot],
+                );
+                let measured = angle_in_frame::<P>(frames.bishop_u[c], frames.bishop_v[c], m1);
+                *angle = unwrap_near(measured, *angle);
+            }
+        }
+    }
+}
