@@ -57,8 +57,8 @@ pub struct RodRest<const N: usize, R = Real> {
 }
 
 impl<const N: usize, R: Scalar> RodRest<N, R> {
-    /// The rest data of the polyline `points` (at most `N` nodes, at least 3; segments checked
-    /// by the caller) with uniform stiffnesses and linear density `λ = ρA`, kg/m.
+    /// The rest data of the polyline `points` (at most `N` nodes are read; fewer than 3 give
+    /// all zeros; segment lengths and fold-backs are checked by the caller) with uniform stiffnesses and linear density `λ = ρA`, kg/m.
     #[must_use]
     pub fn compute<P: Precision<R = R>>(
         points: &[P::V],
@@ -80,6 +80,9 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
             rest_curvature: [[[R::ZERO; 2]; 2]; N],
             stable_time_step: R::of(f32::INFINITY),
         };
+        if nodes < 3 {
+            return rest;
+        }
         let mut shortest = R::of(f32::INFINITY);
         for j in 0..segments {
             let e = points[j + 1] - points[j];
@@ -92,8 +95,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         for i in 1..segments {
             rest.voronoi_length[i] = rest.rest_length[i - 1] + rest.rest_length[i];
         }
-        let root_tangent = points[1] - points[0];
-        let root_frame = perpendicular_unit::<P>(root_tangent * (R::ONE / rest.rest_length[0]));
+        let root_frame = rest_root_frame::<P>(points[0], points[1], rest.rest_length[0]);
         let frames = RodFrames::<P, N>::compute(&points[..nodes], root_frame, &rest.rest_length);
         // θ̂: each segment's angle follows its binormals, the representative mod π closest to
         // the previous segment (least rest twist); straight runs continue the previous angle.
@@ -123,6 +125,14 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         }
         rest
     }
+}
+
+/// The root segment's Bishop vector `u^0` at rest, which is also its rest material vector
+/// `m1^0` (`θ̂^0 = 0`): perpendicular to the rest root tangent. The state starts with it, and
+/// the head carries it to set `θ^0` each step.
+#[must_use]
+pub fn rest_root_frame<P: Precision>(root: P::V, next: P::V, rest_length: P::R) -> P::V {
+    perpendicular_unit::<P>((next - root) * (P::R::ONE / rest_length))
 }
 
 /// The representative of the direction `(cos φ, sin φ)` (an unoriented line, defined mod π)

@@ -154,6 +154,12 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
                 best_energy = energy;
             }
         }
+        // The zero-local-twist continuation competes too: where the binormal barely bends the
+        // segment (nearly straight, µ ≈ 1) aligning with it only adds twist.
+        let (s, c) = P::sin_cos(reference);
+        if local_energy(frames, rest, terms, theta, j, reference, [c, s]) < best_energy {
+            best = reference;
+        }
         theta[j] = best;
     }
 }
