@@ -195,14 +195,21 @@ fn external_forces_and_integrate<const N: usize>(
         0.0
     };
     let state = &mut strand.state;
-    for i in 2..n {
-        let inverse_mass = strand.rest.inverse_mass[i];
-        let mut a = ctx.gravity + (forces[i] - state.velocity[i] * drag) * inverse_mass;
+    let nodes = state
+        .position
+        .iter_mut()
+        .zip(state.velocity.iter_mut())
+        .zip(forces.iter().zip(&strand.rest.inverse_mass))
+        .enumerate()
+        .take(n)
+        .skip(2);
+    for (i, ((x, v), (force, inverse_mass))) in nodes {
+        let mut a = ctx.gravity + (*force - *v * drag) * *inverse_mass;
         if let Some(extra) = accelerations.and_then(|acc| acc.get(i)) {
             a += *extra;
         }
-        state.velocity[i] += a * h;
-        state.position[i] += state.velocity[i] * h;
+        *v += a * h;
+        *x += *v * h;
     }
 }
 
@@ -230,11 +237,8 @@ fn root_coupling<M: Math, const N: usize>(
     let tangent = unit::<M>(state.position[1] - state.position[0]);
     let u = transport_in_time::<M>(old_tangent, tangent, state.root_frame);
     let rest = &strand.rest;
-    let rest_material = rest_root_frame::<M>(
-        rest.position[0],
-        rest.position[1],
-        rest.segment_length[0],
-    );
+    let rest_material =
+        rest_root_frame::<M>(rest.position[0], rest.position[1], rest.segment_length[0]);
     let material = ctx.head.transform_vector(rest_material);
     let angle = angle_in_frame::<M>(u, tangent.cross(u), material);
     state.theta[0] = unwrap_near(angle, state.theta[0]);
