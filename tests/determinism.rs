@@ -23,6 +23,10 @@ fn glam_math_goes_through_libm() {
         let angle = -50.0 + i as f32 * 0.005_123;
         let v = glam::Vec2::from_angle(angle);
         let (s, c) = libm::sincosf(angle);
-        assert_eq!((v.y.to_bits(), v.x.to_bits()), (s.to_bits(), c.to_bits()), "angle {angle}");
+        assert_eq!(
+            (v.y.to_bits(), v.x.to_bits()),
+            (s.to_bits(), c.to_bits()),
+            "angle {angle}"
+        );
     }
 }
