@@ -20,6 +20,11 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+// Unit tests print the figures they measure and use std's float functions; the library never
+// links std.
+#[cfg(test)]
+extern crate std; // cfg(test) only
+
 pub mod collide;
 pub mod context;
 pub mod effects;

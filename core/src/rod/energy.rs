@@ -48,6 +48,9 @@ pub struct RodRest<const N: usize, R = Real> {
     pub rest_theta: [R; N],
     /// Rest twist `m̂_i = θ̂^i − θ̂^{i−1}`, rad.
     pub rest_twist: [R; N],
+    /// `(cos m̂_i, sin m̂_i)`: the hair-optimised twist continues a segment's frame by this
+    /// rotation without calling `sin`/`cos` per node.
+    pub rest_twist_rotation: [[R; 2]; N],
     /// Rest material curvatures `[ω̂^{i−1}_i, ω̂^i_i]` per node.
     pub rest_curvature: [[[R; 2]; 2]; N],
     /// Largest stable explicit time step of the bending forces,
@@ -77,6 +80,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
             twist_stiffness,
             rest_theta: [R::ZERO; N],
             rest_twist: [R::ZERO; N],
+            rest_twist_rotation: [[R::ONE, R::ZERO]; N],
             rest_curvature: [[[R::ZERO; 2]; 2]; N],
             stable_time_step: R::of(f32::INFINITY),
         };
@@ -106,6 +110,8 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
                 None => previous,
             };
             rest.rest_twist[j] = rest.rest_theta[j] - rest.rest_theta[j - 1];
+            let (s, c) = P::sin_cos(rest.rest_twist[j]);
+            rest.rest_twist_rotation[j] = [c, s];
         }
         let cos_sin = material_angles::<P, N>(&rest.rest_theta[..segments]);
         for i in 1..segments {

@@ -122,9 +122,13 @@ fn local_energy<P: Precision, const N: usize>(
 /// already-updated `θ^{j−1}`: take the binormal direction ([`binormal_direction`]) as the
 /// representative mod π nearest `θ^{j−1} + m̂_j`, then keep whichever of `θ`, `θ + π`, `θ − π`
 /// has the least local energy, evaluated exactly (the paper's closed-form criteria assume
-/// uniform `l̂` and neighbours at rest twist). `ω(θ ± π) = −ω(θ)`, so the three candidates cost
-/// one material-curvature evaluation. Without binormals the segment continues its neighbour
-/// at zero local twist, `θ^{j−1} + m̂_j`. Angles stay continuous in time: every choice is made
+/// uniform `l̂` and neighbours at rest twist). `ω(θ ± π) = −ω(θ)`. One candidate is added to
+/// the paper's three: the continuation at zero local twist `θ^{j−1} + m̂_j`, which is also the
+/// choice when both binormals vanish. Without it a nearly straight strand (binormals of
+/// rounding size, directions at random) takes random angles with up to π/2 of twist per
+/// segment and, with µ > 1, pumps energy into the bending modes until it diverges (seen at
+/// ×100 stiffness under a shaking head). Trigonometry: one `atan2` per segment (θ is stored as
+/// an angle); the cosines and sines are carried along the sweep. Angles stay continuous in time: every choice is made
 /// relative to the neighbour, and `θ^0` is unwrapped against its previous value.
 pub fn hair_optimised_twist<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
@@ -134,33 +138,52 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
     theta: &mut [P::R],
 ) {
     let segments = frames.nodes.saturating_sub(1).min(theta.len());
+    if segments == 0 {
+        return;
+    }
+    // (cos θ^{j−1}, sin θ^{j−1}), carried down the strand: one sin_cos per strand (and per
+    // clamped segment), none per node.
+    let (s, c) = P::sin_cos(theta[0]);
+    let mut previous = [c, s];
     for j in 1..segments {
         if clamped.contains(j) {
+            let (s, c) = P::sin_cos(theta[j]);
+            previous = [c, s];
             continue;
         }
+        // Zero local twist: θ^{j−1} + m̂_j, its cosine and sine by the rest rotation.
         let reference = theta[j - 1] + rest.rest_twist[j];
+        let [cm, sm] = rest.rest_twist_rotation[j];
+        let reference_cos_sin = [
+            previous[0] * cm - previous[1] * sm,
+            previous[1] * cm + previous[0] * sm,
+        ];
         let Some(direction) = binormal_direction(frames, j) else {
             theta[j] = reference;
+            previous = reference_cos_sin;
             continue;
         };
         let (angle, cos_sin) = nearest_representative::<P>(direction, reference);
         let flipped = [-cos_sin[0], -cos_sin[1]];
-        let mut best = angle;
-        let mut best_energy = local_energy(frames, rest, terms, theta, j, angle, cos_sin);
-        for candidate in [angle + P::R::PI, angle - P::R::PI] {
-            let energy = local_energy(frames, rest, terms, theta, j, candidate, flipped);
+        let candidates = [
+            (angle, cos_sin),
+            (angle + P::R::PI, flipped),
+            (angle - P::R::PI, flipped),
+            // The continuation competes too: where the binormal barely bends the segment
+            // (nearly straight, µ ≈ 1) aligning with it would only add twist.
+            (reference, reference_cos_sin),
+        ];
+        let mut best = candidates[0];
+        let mut best_energy = local_energy(frames, rest, terms, theta, j, best.0, best.1);
+        for candidate in &candidates[1..] {
+            let energy = local_energy(frames, rest, terms, theta, j, candidate.0, candidate.1);
             if energy < best_energy {
-                best = candidate;
+                best = *candidate;
                 best_energy = energy;
             }
         }
-        // The zero-local-twist continuation competes too: where the binormal barely bends the
-        // segment (nearly straight, µ ≈ 1) aligning with it only adds twist.
-        let (s, c) = P::sin_cos(reference);
-        if local_energy(frames, rest, terms, theta, j, reference, [c, s]) < best_energy {
-            best = reference;
-        }
-        theta[j] = best;
+        theta[j] = best.0;
+        previous = best.1;
     }
 }
 
@@ -432,8 +455,6 @@ impl<P: Precision> ClampedFrames<P> {
 
 #[cfg(test)]
 mod tests {
-    extern crate std;
-
     use super::*;
     use crate::frames::transport_in_time;
     use crate::precision::F64;

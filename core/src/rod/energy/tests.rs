@@ -7,8 +7,6 @@
 //! likewise (DESIGN.md), free angles are either held (hair-optimised twist: `F = −∂E/∂x` at
 //! fixed `θ`) or re-minimised by Newton (`F = −dE/dx`).
 
-extern crate std;
-
 use super::*;
 use crate::frames::transport_in_time;
 use crate::precision::F64;

@@ -5,8 +5,6 @@
 //! segment lengths, root nodes fixed, velocity corrected by the position change / dt), so that
 //! the hanging strands do not stretch without bound under gravity.
 
-extern crate std;
-
 use super::*;
 use crate::effects::Effects;
 use crate::head::{Pose, Shake};
