@@ -20,7 +20,7 @@
 
 use super::twist::binormal_direction;
 use super::{ClampedSegments, ElasticTerms};
-use crate::frames::{bishop_frame, curvature_binormal, material_frame, perpendicular_unit};
+use crate::frames::{curvature_binormal, material_frame, parallel_transport, perpendicular_unit};
 use crate::math::Real;
 use crate::precision::{Precision, Scalar, Vector};
 
@@ -37,6 +37,8 @@ pub struct RodRest<const N: usize, R = Real> {
     pub rest_length: [R; N],
     /// `l̂_i = |ê^{i−1}| + |ê^i|`, m (twice the node's Voronoi length).
     pub voronoi_length: [R; N],
+    /// `1 / l̂_i` (zero where `l̂_i` is unused): the kernels multiply instead of dividing.
+    pub inverse_voronoi_length: [R; N],
     /// Bending stiffness `α^j` per segment, N·m².
     pub bending_stiffness: [R; N],
     /// `µ`: `B^j = diag(µ α^j, α^j)`.
@@ -75,6 +77,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         let mut rest = RodRest {
             rest_length: [R::ZERO; N],
             voronoi_length: [R::ZERO; N],
+            inverse_voronoi_length: [R::ZERO; N],
             bending_stiffness: [R::ZERO; N],
             minor_axis_penalty,
             twist_stiffness,
@@ -98,6 +101,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         }
         for i in 1..segments {
             rest.voronoi_length[i] = rest.rest_length[i - 1] + rest.rest_length[i];
+            rest.inverse_voronoi_length[i] = R::ONE / rest.voronoi_length[i];
         }
         let root_frame = rest_root_frame::<P>(points[0], points[1], rest.rest_length[0]);
         let frames = RodFrames::<P, N>::compute(&points[..nodes], root_frame, &rest.rest_length);
@@ -200,29 +204,33 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
             bishop_v: [zero; N],
             bishop_curvature: [[[P::R::ZERO; 2]; 2]; N],
         };
-        let segments = f.nodes.saturating_sub(1);
+        let segments = f.nodes.saturating_sub(1).min(rest_length.len());
+        // One pass root → tip: segment, tangent, Bishop frame by parallel transport (Kmoch
+        // Sec. 5), then the binormal at the node behind it and its Bishop components.
         for j in 0..segments {
             let e = positions[j + 1] - positions[j];
             let length = P::sqrt(e.dot(e));
+            let t = e * (P::R::ONE / length);
+            let u = if j == 0 {
+                root_frame
+            } else {
+                parallel_transport::<P>(f.tangent[j - 1], t, f.bishop_u[j - 1])
+            };
             f.edge[j] = e;
             f.length[j] = length;
-            f.tangent[j] = e * (P::R::ONE / length);
-        }
-        bishop_frame::<P>(&f.tangent[..segments], root_frame, &mut f.bishop_u);
-        for j in 0..segments {
-            f.bishop_v[j] = f.tangent[j].cross(f.bishop_u[j]);
-        }
-        for i in 1..segments {
-            let (rest_prev, rest_next) = match (rest_length.get(i - 1), rest_length.get(i)) {
-                (Some(a), Some(b)) => (*a, *b),
-                _ => break,
-            };
-            let (kb, d) = curvature_binormal::<P>(f.edge[i - 1], f.edge[i], rest_prev, rest_next);
-            f.curvature_binormal[i] = kb;
-            f.denominator[i] = d;
-            for k in 0..2 {
-                let j = i - 1 + k;
-                f.bishop_curvature[i][k] = [kb.dot(f.bishop_v[j]), -kb.dot(f.bishop_u[j])];
+            f.tangent[j] = t;
+            f.bishop_u[j] = u;
+            f.bishop_v[j] = t.cross(u);
+            if j > 0 {
+                let i = j;
+                let (kb, d) =
+                    curvature_binormal::<P>(f.edge[i - 1], e, rest_length[i - 1], rest_length[i]);
+                f.curvature_binormal[i] = kb;
+                f.denominator[i] = d;
+                f.bishop_curvature[i] = [
+                    [kb.dot(f.bishop_v[i - 1]), -kb.dot(f.bishop_u[i - 1])],
+                    [kb.dot(f.bishop_v[i]), -kb.dot(f.bishop_u[i])],
+                ];
             }
         }
         f
@@ -298,7 +306,7 @@ pub fn node_bending_energy<P: Precision, const N: usize>(
     let b = bending_matrix(rest, terms, i - 1 + k);
     let d0 = omega[0] - rest_omega[0];
     let d1 = omega[1] - rest_omega[1];
-    (b[0] * d0 * d0 + b[1] * d1 * d1) * (P::R::of(0.5) / rest.voronoi_length[i])
+    (b[0] * d0 * d0 + b[1] * d1 * d1) * (P::R::of(0.5) * rest.inverse_voronoi_length[i])
 }
 
 /// Twist energy at node `i`: `β (θ^i − θ^{i−1} − m̂_i)² / l̂_i`.
@@ -312,7 +320,7 @@ pub fn node_twist_energy<const N: usize, R: Scalar>(
     theta: R,
 ) -> R {
     let m = theta - theta_prev - rest.rest_twist[i];
-    twist_stiffness(rest, terms) * m * m / rest.voronoi_length[i]
+    twist_stiffness(rest, terms) * m * m * rest.inverse_voronoi_length[i]
 }
 
 /// The total elastic energy `E_bend + E_twist`, J.
@@ -349,7 +357,7 @@ fn bending_terms<P: Precision, const N: usize>(
     let omega = material_curvature(frames.bishop_curvature[i][k], cos_sin);
     let rest_omega = rest.rest_curvature[i][k];
     let b = bending_matrix(rest, terms, j);
-    let inv_l = P::R::ONE / rest.voronoi_length[i];
+    let inv_l = rest.inverse_voronoi_length[i];
     let b_delta = [
         b[0] * (omega[0] - rest_omega[0]) * inv_l,
         b[1] * (omega[1] - rest_omega[1]) * inv_l,
@@ -394,11 +402,14 @@ pub fn twist_twist_derivative<const N: usize, R: Scalar>(
     let two_beta = R::of(2.0) * twist_stiffness(rest, terms);
     let mut g = R::ZERO;
     if j >= 1 && j <= n {
-        g += two_beta * (theta[j] - theta[j - 1] - rest.rest_twist[j]) / rest.voronoi_length[j];
+        g += two_beta
+            * (theta[j] - theta[j - 1] - rest.rest_twist[j])
+            * rest.inverse_voronoi_length[j];
     }
     if j < n {
-        g -= two_beta * (theta[j + 1] - theta[j] - rest.rest_twist[j + 1])
-            / rest.voronoi_length[j + 1];
+        g -= two_beta
+            * (theta[j + 1] - theta[j] - rest.rest_twist[j + 1])
+            * rest.inverse_voronoi_length[j + 1];
     }
     g
 }

@@ -12,7 +12,7 @@
 //! by the time-parallel transport of their material frame.
 
 use super::energy::{
-    bending_matrix, bending_twist_derivative, material_angles, material_curvature,
+    bending_matrix, bending_twist_derivative, elastic_energy, material_angles, material_curvature,
     nearest_representative, node_bending_energy, node_twist_energy, twist_stiffness,
     twist_twist_derivative, RodFrames, RodRest,
 };
@@ -202,6 +202,42 @@ pub struct NewtonOutcome {
 /// can overshoot by turns; a quarter turn keeps the iteration in the basin.
 const MAX_NEWTON_STEP: f32 = core::f32::consts::FRAC_PI_2;
 
+/// Backtracking on the energy (at most [`LINE_SEARCH_HALVINGS`] halvings): takes
+/// `θ ← θ − a·s` with the first `a = 1, ½, ¼, …` that does not raise `E`, so the iteration
+/// never climbs out of the current basin (without it, on a nearly straight strand with µ > 1,
+/// where the twist minimum is shallow, Gauss–Newton steps jump θ by radians from step to step).
+/// Returns the largest angle change made.
+fn line_search<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    terms: ElasticTerms,
+    step: &[P::R],
+    theta: &mut [P::R],
+) -> P::R {
+    let segments = step.len().min(theta.len()).min(N);
+    let mut trial = [P::R::ZERO; N];
+    let start = elastic_energy(frames, &theta[..segments], rest, terms);
+    let mut scale = P::R::ONE;
+    for _ in 0..=LINE_SEARCH_HALVINGS {
+        for ((t, theta), s) in trial.iter_mut().zip(theta.iter()).zip(step) {
+            *t = *theta - *s * scale;
+        }
+        if elastic_energy(frames, &trial[..segments], rest, terms) <= start {
+            theta[..segments].copy_from_slice(&trial[..segments]);
+            let largest = step
+                .iter()
+                .fold(P::R::ZERO, |m, s| if s.abs() > m { s.abs() } else { m });
+            return largest * scale;
+        }
+        scale *= P::R::of(0.5);
+    }
+    // No decrease at any scale: θ is at the minimum to rounding.
+    P::R::ZERO
+}
+
+/// Most halvings of a Newton step in [`line_search`].
+const LINE_SEARCH_HALVINGS: u32 = 4;
+
 /// BWR08's Newton twist: minimises `E` over the unclamped `θ^j` in place.
 ///
 /// Bending is separable in `θ` and only twist couples neighbours, so the Hessian is
@@ -209,7 +245,8 @@ const MAX_NEWTON_STEP: f32 = core::f32::consts::FRAC_PI_2;
 /// `H_{j−1,j} = −2β/l̂_j`. Clamped segments are Dirichlet rows (an interior clamp splits the
 /// system). Far from rest `H_jj` can go negative: when the LDLᵀ of the full Hessian meets a
 /// non-positive pivot, the iteration uses Gauss–Newton (the `−ωᵀB(ω−ω̂)` term dropped, positive
-/// semi-definite plus the twist Laplacian). Stops when the largest update is `≤ tolerance` rad,
+/// semi-definite plus the twist Laplacian), and every step is safeguarded by a backtracking
+/// line search on `E` (BWR08 leaves globalisation open). Stops when the largest update is `≤ tolerance` rad,
 /// unless `fixed_cost`, which always runs `iterations` (bounded latency).
 #[allow(clippy::too_many_arguments)]
 pub fn newton_twist<P: Precision, const N: usize>(
@@ -267,20 +304,14 @@ pub fn newton_twist<P: Precision, const N: usize>(
             );
         }
         let limit = P::R::of(MAX_NEWTON_STEP);
-        let mut largest = P::R::ZERO;
-        for (t, s) in theta.iter_mut().zip(&step[..segments]) {
-            let s = if *s > limit {
-                limit
+        for s in step[..segments].iter_mut() {
+            if *s > limit {
+                *s = limit;
             } else if *s < -limit {
-                -limit
-            } else {
-                *s
-            };
-            *t -= s;
-            if s.abs() > largest {
-                largest = s.abs();
+                *s = -limit;
             }
         }
+        let largest = line_search(frames, rest, terms, &step[..segments], theta);
         outcome.converged = largest <= tolerance;
         if outcome.converged && !fixed_cost {
             break;
@@ -322,7 +353,7 @@ pub fn twist_newton_system<P: Precision, const N: usize>(
         let node = |i: usize, k: usize| {
             let omega = material_curvature(frames.bishop_curvature[i][k], cos_sin[j]);
             let rest_omega = rest.rest_curvature[i][k];
-            let inv_l = P::R::ONE / rest.voronoi_length[i];
+            let inv_l = rest.inverse_voronoi_length[i];
             let gn = (b[0] * omega[1] * omega[1] + b[1] * omega[0] * omega[0]) * inv_l;
             let curvature = (b[0] * omega[0] * (omega[0] - rest_omega[0])
                 + b[1] * omega[1] * (omega[1] - rest_omega[1]))
@@ -336,7 +367,7 @@ pub fn twist_newton_system<P: Precision, const N: usize>(
             gn += g;
             curvature += c;
             if !clamped.contains(j - 1) {
-                coupling[j] = -two_beta / rest.voronoi_length[j];
+                coupling[j] = -two_beta * rest.inverse_voronoi_length[j];
             }
         }
         if j < n {
