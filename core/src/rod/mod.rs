@@ -5,6 +5,8 @@
 //! * [`twist`] — the quasistatic twist: hair-optimised (Sec. 6.2) or Newton (BWR08).
 //! * [`step`] — Algorithm 1 as a list of stages.
 
+use crate::grab::{Grab, GrabStatus};
+
 pub mod energy;
 pub mod step;
 pub mod twist;
@@ -47,6 +49,28 @@ impl ClampedSegments {
         }
     }
 
+    /// The clamped set of strand `strand_index` (`nodes` nodes) under `grabs`: the root, plus
+    /// for each held grab of a node `g ≥ 2` of this strand the segment `e^g` that starts at it
+    /// (`e^{g−1}` for the tip node). Grabs beyond [`MAX_CLAMPED`] are not clamped (they still
+    /// pin their node in the projection).
+    #[must_use]
+    pub fn from_grabs(grabs: &[Grab], strand_index: u32, nodes: usize) -> ClampedSegments {
+        let mut set = ClampedSegments::ROOT_ONLY;
+        for grab in grabs {
+            let node = grab.node as usize;
+            if grab.strand != strand_index || grab.status != GrabStatus::Held || node >= nodes {
+                continue;
+            }
+            let segment = if node + 1 < nodes {
+                node
+            } else {
+                node.saturating_sub(1)
+            };
+            let _ = set.insert(segment);
+        }
+        set
+    }
+
     /// Whether segment `segment` is clamped (always for segment 0).
     #[must_use]
     pub fn contains(&self, segment: usize) -> bool {
@@ -76,4 +100,31 @@ impl ElasticTerms {
         bending: true,
         twist: true,
     };
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+
+    #[test]
+    fn grabs_clamp_their_segment_on_their_strand_only() {
+        let mut released = Grab::new(1, 5, Vec3::ZERO, 1.0);
+        released.status = GrabStatus::Released;
+        let grabs = [
+            Grab::new(1, 4, Vec3::ZERO, 1.0),
+            Grab::new(0, 7, Vec3::ZERO, 1.0),
+            Grab::new(1, 9, Vec3::ZERO, 1.0),
+            released,
+        ];
+        let set = ClampedSegments::from_grabs(&grabs, 1, 10);
+        assert!(set.contains(0) && set.contains(4) && set.contains(8));
+        assert!(!set.contains(5) && !set.contains(7) && !set.contains(9));
+        assert_eq!(set.others().count(), 2);
+        let mut full = ClampedSegments::ROOT_ONLY;
+        for s in 1..=MAX_CLAMPED {
+            assert!(full.insert(s));
+        }
+        assert!(!full.insert(MAX_CLAMPED + 1) && full.insert(3));
+    }
 }

@@ -50,7 +50,9 @@ pub fn step<M: Math, const N: usize>(
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
-    // The projection (core/src/projection/) adds grabbed nodes' segments to this set.
+    // With grabs on, a grabbed node's segment is clamped too: once the step knows its strand's
+    // index (the projection branch adds it), this becomes
+    // `ClampedSegments::from_grabs(grabs, strand_index, strand.rest.nodes)`.
     let clamped = ClampedSegments::ROOT_ONLY;
     let terms = elastic_terms(ctx);
     let start = StepStart::<M>::capture(strand, &clamped, terms);

@@ -13,8 +13,8 @@
 
 use super::energy::{
     bending_matrix, bending_twist_derivative, elastic_energy, material_angles, material_curvature,
-    nearest_representative, node_bending_energy, node_twist_energy, twist_stiffness,
-    twist_twist_derivative, RodFrames, RodRest,
+    nearest_representative, node_twist_energy, twist_stiffness, twist_twist_derivative, RodFrames,
+    RodRest,
 };
 use super::{ClampedSegments, ElasticTerms, MAX_CLAMPED};
 use crate::frames::{angle_in_frame, material_frame, parallel_transport, unwrap_near};
@@ -92,25 +92,52 @@ pub fn binormal_direction<P: Precision, const N: usize>(
     })
 }
 
-/// The elastic energy that depends on `θ^j`: bending at nodes `j`, `j + 1` in frame `j` and
-/// twist at nodes `j`, `j + 1`, with the neighbours' current angles.
-fn local_energy<P: Precision, const N: usize>(
+/// The bending energy of nodes `j`, `j + 1` in frame `j` at `θ` and at `θ ± π`:
+/// `Σ_i ½(1/l̂_i)(±ω − ω̂)ᵀB(±ω − ω̂)`, since `ω(θ ± π) = −ω(θ)`. Each is summed as squares
+/// (not expanded), so near rest the comparison is not lost to cancellation.
+fn local_bending<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,
-    theta: &[P::R],
     j: usize,
-    candidate: P::R,
     cos_sin: [P::R; 2],
-) -> P::R {
+) -> (P::R, P::R) {
     let n = frames.interior();
-    let mut energy = P::R::ZERO;
+    let b = bending_matrix(rest, terms, j);
+    let half = P::R::of(0.5);
+    let mut energies = (P::R::ZERO, P::R::ZERO);
+    let mut node = |i: usize, k: usize| {
+        let w = material_curvature(frames.bishop_curvature[i][k], cos_sin);
+        let r = rest.rest_curvature[i][k];
+        let scale = half * rest.inverse_voronoi_length[i];
+        let (d0, d1) = (w[0] - r[0], w[1] - r[1]);
+        let (f0, f1) = (w[0] + r[0], w[1] + r[1]);
+        energies.0 += (b[0] * d0 * d0 + b[1] * d1 * d1) * scale;
+        energies.1 += (b[0] * f0 * f0 + b[1] * f1 * f1) * scale;
+    };
     if j >= 1 && j <= n {
-        energy += node_bending_energy(frames, rest, terms, j, 1, cos_sin);
+        node(j, 1);
+    }
+    if j < n {
+        node(j + 1, 0);
+    }
+    energies
+}
+
+/// The twist energy of nodes `j`, `j + 1` with `θ^j = candidate` and the neighbours' angles.
+fn local_twist<const N: usize, R: Scalar>(
+    rest: &RodRest<N, R>,
+    terms: ElasticTerms,
+    theta: &[R],
+    j: usize,
+    n: usize,
+    candidate: R,
+) -> R {
+    let mut energy = R::ZERO;
+    if j >= 1 && j <= n {
         energy += node_twist_energy(rest, terms, j, theta[j - 1], candidate);
     }
     if j < n {
-        energy += node_bending_energy(frames, rest, terms, j + 1, 0, cos_sin);
         energy += node_twist_energy(rest, terms, j + 1, candidate, theta[j + 1]);
     }
     energy
@@ -141,6 +168,7 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
     if segments == 0 {
         return;
     }
+    let n = frames.interior();
     // (cos θ^{j−1}, sin θ^{j−1}), carried down the strand: one sin_cos per strand (and per
     // clamped segment), none per node.
     let (s, c) = P::sin_cos(theta[0]);
@@ -164,21 +192,24 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
             continue;
         };
         let (angle, cos_sin) = nearest_representative::<P>(direction, reference);
+        let (aligned, flipped_bending) = local_bending(frames, rest, terms, j, cos_sin);
+        let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
         let flipped = [-cos_sin[0], -cos_sin[1]];
+        let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
         let candidates = [
-            (angle, cos_sin),
-            (angle + P::R::PI, flipped),
-            (angle - P::R::PI, flipped),
+            (angle, cos_sin, aligned),
+            (angle + P::R::PI, flipped, flipped_bending),
+            (angle - P::R::PI, flipped, flipped_bending),
             // The continuation competes too: where the binormal barely bends the segment
             // (nearly straight, µ ≈ 1) aligning with it would only add twist.
-            (reference, reference_cos_sin),
+            (reference, reference_cos_sin, continued),
         ];
-        let mut best = candidates[0];
-        let mut best_energy = local_energy(frames, rest, terms, theta, j, best.0, best.1);
-        for candidate in &candidates[1..] {
-            let energy = local_energy(frames, rest, terms, theta, j, candidate.0, candidate.1);
+        let mut best = (candidates[0].0, candidates[0].1);
+        let mut best_energy = candidates[0].2 + twist(candidates[0].0);
+        for &(candidate, candidate_cos_sin, bending) in &candidates[1..] {
+            let energy = bending + twist(candidate);
             if energy < best_energy {
-                best = *candidate;
+                best = (candidate, candidate_cos_sin);
                 best_energy = energy;
             }
         }
