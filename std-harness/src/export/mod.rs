@@ -84,6 +84,9 @@ pub enum ExportError {
         /// Strand 0's.
         first: usize,
     },
+    /// A strand width that is negative or not finite.
+    #[error("bad strand width {0}: must be finite and >= 0")]
+    BadWidth(f32),
     /// The path's extension names no format.
     #[error("{0}: unknown extension (expected .obj, .ply, .hair, .usda or .tfx)")]
     UnknownExtension(String),

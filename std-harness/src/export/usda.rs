@@ -18,6 +18,9 @@ pub fn write_usda<W: Write, S: AsRef<[Vec3]>>(
     width: f32,
 ) -> Result<(), ExportError> {
     check_strands(strands)?;
+    if !(width.is_finite() && width >= 0.0) {
+        return Err(ExportError::BadWidth(width));
+    }
     let mut out = BufWriter::new(out);
     writeln!(out, "#usda 1.0")?;
     writeln!(out, "(")?;
@@ -31,6 +34,20 @@ pub fn write_usda<W: Write, S: AsRef<[Vec3]>>(
     writeln!(out, "{{")?;
     writeln!(out, "    uniform token type = \"linear\"")?;
     writeln!(out, "    uniform token wrap = \"nonperiodic\"")?;
+    // Bounds of the curves swept by their width, which USD asks of every boundable prim.
+    if let Some((lo, hi)) = crate::hairfile::bounds_of(strands) {
+        let (lo, hi) = (lo - Vec3::splat(0.5 * width), hi + Vec3::splat(0.5 * width));
+        writeln!(
+            out,
+            "    float3[] extent = [({}, {}, {}), ({}, {}, {})]",
+            Num(lo.x),
+            Num(lo.y),
+            Num(lo.z),
+            Num(hi.x),
+            Num(hi.y),
+            Num(hi.z)
+        )?;
+    }
     write!(out, "    int[] curveVertexCounts = [")?;
     for (i, s) in strands.iter().enumerate() {
         let sep = if i == 0 { "" } else { ", " };
@@ -159,6 +176,11 @@ mod tests {
         assert!(text.contains("int[] curveVertexCounts = [3, 2, 40]"));
         assert!(text.contains("uniform token type = \"linear\""));
         assert!(text.contains("float[] widths = [8e-5]"));
+        assert!(text.contains("float3[] extent = [("));
+        assert!(matches!(
+            write_usda(Vec::new(), &strands, f32::NAN),
+            Err(ExportError::BadWidth(_))
+        ));
         assert_same_bits(&read_usda(&text).unwrap(), &strands);
     }
 
