@@ -105,19 +105,13 @@ pub fn read_usda(text: &str) -> Result<Vec<Vec<Vec3>>, TextReadError> {
             .find(')')
             .ok_or_else(|| TextReadError::new(F, line_of(rest), "unclosed point"))?;
         let tuple = &rest[open + 1..open + close];
-        let mut c = tuple.split(',').map(str::trim);
-        let line = line_of(tuple);
-        let x = super::parse_coordinate(F, line, c.next())?;
-        let y = super::parse_coordinate(F, line, c.next())?;
-        let z = super::parse_coordinate(F, line, c.next())?;
-        if c.next().is_some() {
-            return Err(TextReadError::new(
-                F,
-                line,
-                "point with more than 3 coordinates",
-            ));
-        }
-        points.push(Vec3::new(x, y, z));
+        // The line number is counted only on error: counting it for every point would make
+        // reading quadratic in the file's size.
+        let point = parse_point(tuple).map_err(|mut e| {
+            e.line = line_of(tuple);
+            e
+        })?;
+        points.push(point);
         rest = &rest[open + close + 1..];
     }
     let total = counts.iter().try_fold(0usize, |a, &n| a.checked_add(n));
@@ -138,6 +132,22 @@ pub fn read_usda(text: &str) -> Result<Vec<Vec<Vec3>>, TextReadError> {
         at += n;
     }
     Ok(strands)
+}
+
+/// `x, y, z` (line 0: the caller fills it in).
+fn parse_point(tuple: &str) -> Result<Vec3, TextReadError> {
+    let mut c = tuple.split(',').map(str::trim);
+    let x = super::parse_coordinate("USDA", 0, c.next())?;
+    let y = super::parse_coordinate("USDA", 0, c.next())?;
+    let z = super::parse_coordinate("USDA", 0, c.next())?;
+    if c.next().is_some() {
+        return Err(TextReadError::new(
+            "USDA",
+            0,
+            "point with more than 3 coordinates",
+        ));
+    }
+    Ok(Vec3::new(x, y, z))
 }
 
 /// The text between the brackets of `name … = [ … ]`.
@@ -191,6 +201,6 @@ mod tests {
         assert!(e.message.contains("add up"), "{e}");
         assert!(read_usda("point3f[] points = [(0, 0, 0)]").is_err());
         let nan = "int[] curveVertexCounts = [2]\npoint3f[] points = [(0, 0, 0), (nan, 0, 0)]\n";
-        assert!(read_usda(nan).is_err());
+        assert_eq!(read_usda(nan).unwrap_err().line, 2);
     }
 }
