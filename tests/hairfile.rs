@@ -614,3 +614,28 @@ fn mutated_seeds_never_panic_or_over_allocate() {
         "only {refused} of 4000 mutated files refused"
     );
 }
+
+/// The GIF writer streams: its peak memory does not grow with the number of frames.
+#[test]
+fn gif_writer_memory_does_not_grow_with_frames() {
+    use hairsim::picture::{Camera, GifWriter, Style, View};
+    let strands = wavy(20, |_| 12);
+    let camera = Camera::fit_reach(&strands, &[], View::Front, 96, 96);
+    let peak_for = |frames: usize| {
+        peak_of(|| {
+            let mut gif = GifWriter::new(std::io::sink(), camera, Style::default(), 4).unwrap();
+            for k in 0..frames {
+                let mut s = strands.clone();
+                s.iter_mut().flatten().for_each(|p| p.x += 0.001 * k as f32);
+                gif.add_frame(&s, &[]).unwrap();
+            }
+            gif.finish().unwrap();
+        })
+        .1
+    };
+    let (two, twenty) = (peak_for(2), peak_for(20));
+    assert!(
+        twenty <= two + two / 10,
+        "peak {twenty} bytes for 20 frames vs {two} for 2"
+    );
+}
