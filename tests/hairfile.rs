@@ -15,6 +15,8 @@ use hairsim::export::{
 use hairsim::hairfile::{
     polyline_length, read_hair, read_tfx, HairFileError, HairModel, ReadOptions, UpAxis,
 };
+use hairsim_core::scenes::firmware;
+use hairsim_core::{Libm, World};
 
 /// Counts the bytes live on the current thread while tracking is on, and their peak. Per
 /// thread, because the test harness runs tests in parallel in one process.
@@ -638,4 +640,68 @@ fn gif_writer_memory_does_not_grow_with_frames() {
         twenty <= two + two / 10,
         "peak {twenty} bytes for 20 frames vs {two} for 2"
     );
+}
+
+type FirmwareWorld = World<{ firmware::STRANDS }, { firmware::NODES }, Libm>;
+
+/// A frame as `OutDir` takes it: strand positions borrowed from the world, colliders in world
+/// coordinates (head-attached ones moved by the head's pose).
+fn frame(world: &FirmwareWorld) -> (Vec<&[Vec3]>, Vec<hairsim_core::Shape>) {
+    let strands = world.strands().iter().map(|s| s.positions()).collect();
+    let head = world.head();
+    let colliders = world
+        .colliders()
+        .iter()
+        .map(|c| {
+            if c.attached_to_head {
+                c.shape.transformed(&head)
+            } else {
+                c.shape
+            }
+        })
+        .collect();
+    (strands, colliders)
+}
+
+/// The glue `hairsim run --out DIR` needs, on the firmware scene: strands straight from the
+/// core's `World`, head-attached colliders moved by the head's pose, frames every 100 steps.
+/// Set `HAIRSIM_PICTURES=DIR` to keep the output for a look.
+#[test]
+fn a_core_world_run_goes_through_out_dir() {
+    use hairsim::export::{Format, OutDir, OutOptions};
+
+    let dir = std::env::var_os("HAIRSIM_PICTURES").map_or_else(
+        || std::env::temp_dir().join(format!("hairsim-run-out-{}", std::process::id())),
+        PathBuf::from,
+    );
+    let mut world: Box<FirmwareWorld> = Box::default();
+    firmware::build(&mut world).unwrap();
+    let options = OutOptions {
+        frame_formats: vec![Format::Obj, Format::Usda],
+        ..OutOptions::default()
+    };
+    let mut out = OutDir::create(&dir, options).unwrap();
+    for k in 0..300 {
+        if k % 100 == 0 {
+            let (strands, colliders) = frame(&world);
+            out.frame(world.steps(), &strands, &colliders).unwrap();
+        }
+        world.step(&firmware::input::<Libm>(k));
+    }
+    let (strands, colliders) = frame(&world);
+    let written = out.finish(&strands, &colliders).unwrap();
+    // 3 frames × 2 formats, run.gif, final.obj, final.png.
+    assert_eq!(written.len(), 3 * 2 + 3, "{written:?}");
+    let text = std::fs::read_to_string(dir.join("final.obj")).unwrap();
+    let back = read_obj(&text).unwrap();
+    assert_eq!(back.len(), firmware::STRANDS);
+    assert!(colliders.len() == 1);
+    for (a, b) in back.iter().zip(&strands) {
+        assert_eq!(a.as_slice(), *b);
+    }
+    let png = std::fs::read(dir.join("final.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    if std::env::var_os("HAIRSIM_PICTURES").is_none() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
