@@ -54,6 +54,53 @@ pub struct Contact {
     pub depth: Real,
 }
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for Shape {
+    fn format(&self, f: defmt::Formatter) {
+        use crate::math::DefmtVec3 as V;
+        match *self {
+            Shape::Sphere { centre, radius } => {
+                defmt::write!(f, "Sphere {{ centre: {}, radius: {} }}", V(centre), radius)
+            }
+            Shape::Capsule { a, b, radius } => defmt::write!(
+                f,
+                "Capsule {{ a: {}, b: {}, radius: {} }}",
+                V(a),
+                V(b),
+                radius
+            ),
+            Shape::Plane { point, normal } => {
+                defmt::write!(f, "Plane {{ point: {}, normal: {} }}", V(point), V(normal))
+            }
+        }
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Collider {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Collider {{ shape: {}, attached_to_head: {} }}",
+            self.shape,
+            self.attached_to_head
+        )
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Contact {
+    fn format(&self, f: defmt::Formatter) {
+        use crate::math::DefmtVec3 as V;
+        defmt::write!(
+            f,
+            "Contact {{ normal: {}, depth: {} }}",
+            V(self.normal),
+            self.depth
+        )
+    }
+}
+
 impl Shape {
     /// This shape moved by `pose`.
     #[must_use]
@@ -80,12 +127,16 @@ impl Shape {
     pub fn is_valid(&self) -> bool {
         use crate::math::is_finite;
         match *self {
-            Shape::Sphere { centre, radius } => is_finite(centre) && radius.is_finite() && radius > 0.0,
+            Shape::Sphere { centre, radius } => {
+                is_finite(centre) && radius.is_finite() && radius > 0.0
+            }
             Shape::Capsule { a, b, radius } => {
                 is_finite(a) && is_finite(b) && radius.is_finite() && radius > 0.0
             }
             Shape::Plane { point, normal } => {
-                is_finite(point) && is_finite(normal) && (normal.length_squared() - 1.0).abs() < 1e-4
+                is_finite(point)
+                    && is_finite(normal)
+                    && (normal.length_squared() - 1.0).abs() < 1e-4
             }
         }
     }
@@ -127,7 +178,11 @@ fn ball<M: Math>(p: Vec3, centre: Vec3, radius: Real) -> Option<Contact> {
         return None;
     }
     let distance = M::sqrt(distance2);
-    let normal = if distance > 0.0 { d / distance } else { Vec3::Y };
+    let normal = if distance > 0.0 {
+        d / distance
+    } else {
+        Vec3::Y
+    };
     Some(Contact {
         normal,
         depth: radius - distance,
@@ -145,26 +200,42 @@ mod tests {
             centre: Vec3::ZERO,
             radius: 1.0,
         };
-        let c = sphere.penetration::<Libm>(Vec3::new(0.0, 0.5, 0.0)).unwrap();
+        let c = sphere
+            .penetration::<Libm>(Vec3::new(0.0, 0.5, 0.0))
+            .unwrap();
         assert_eq!(c.normal, Vec3::Y);
         assert!((c.depth - 0.5).abs() < 1e-7);
-        assert!(sphere.penetration::<Libm>(Vec3::new(0.0, 1.5, 0.0)).is_none());
+        assert!(sphere
+            .penetration::<Libm>(Vec3::new(0.0, 1.5, 0.0))
+            .is_none());
 
         let capsule = Shape::Capsule {
             a: Vec3::ZERO,
             b: Vec3::new(2.0, 0.0, 0.0),
             radius: 0.5,
         };
-        let c = capsule.penetration::<Libm>(Vec3::new(1.0, 0.0, 0.25)).unwrap();
+        let c = capsule
+            .penetration::<Libm>(Vec3::new(1.0, 0.0, 0.25))
+            .unwrap();
         assert_eq!(c.normal, Vec3::Z);
         assert!((c.depth - 0.25).abs() < 1e-7);
-        assert!(capsule.penetration::<Libm>(Vec3::new(2.6, 0.0, 0.0)).is_none());
+        assert!(capsule
+            .penetration::<Libm>(Vec3::new(2.6, 0.0, 0.0))
+            .is_none());
 
         let plane = Shape::Plane {
             point: Vec3::ZERO,
             normal: Vec3::Y,
         };
-        assert!((plane.penetration::<Libm>(Vec3::new(3.0, -0.2, 1.0)).unwrap().depth - 0.2).abs() < 1e-7);
+        assert!(
+            (plane
+                .penetration::<Libm>(Vec3::new(3.0, -0.2, 1.0))
+                .unwrap()
+                .depth
+                - 0.2)
+                .abs()
+                < 1e-7
+        );
         assert!(plane.is_valid() && sphere.is_valid() && capsule.is_valid());
     }
 
@@ -172,14 +243,19 @@ mod tests {
     fn transformed_moves_with_the_pose() {
         let pose = Pose {
             position: Vec3::new(1.0, 0.0, 0.0),
-            rotation: crate::math::quat_from_axis_angle::<Libm>(Vec3::Z, core::f32::consts::FRAC_PI_2),
+            rotation: crate::math::quat_from_axis_angle::<Libm>(
+                Vec3::Z,
+                core::f32::consts::FRAC_PI_2,
+            ),
         };
         let moved = Shape::Sphere {
             centre: Vec3::X,
             radius: 1.0,
         }
         .transformed(&pose);
-        let Shape::Sphere { centre, .. } = moved else { panic!() };
+        let Shape::Sphere { centre, .. } = moved else {
+            panic!()
+        };
         assert!((centre - Vec3::new(1.0, 1.0, 0.0)).length() < 1e-6);
     }
 }

@@ -32,6 +32,21 @@ pub struct Grab {
     pub status: GrabStatus,
 }
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for Grab {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Grab {{ strand: {}, node: {}, target: {}, force_limit: {}, status: {} }}",
+            self.strand,
+            self.node,
+            crate::math::DefmtVec3(self.target),
+            self.force_limit,
+            self.status
+        )
+    }
+}
+
 impl Grab {
     /// A grab of `node` on `strand`, held at `target`, slipping above `force_limit` newtons.
     #[must_use]

@@ -66,7 +66,6 @@ impl defmt::Format for Pose {
 /// DESIGN.md's "shaking at 10 rad/s" is `Shake::TEN_RAD_PER_S`: about the vertical axis,
 /// amplitude 0.5 rad, peak angular speed `2π f · 0.5 = 10 rad/s` (f ≈ 3.18 Hz).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Shake {
     /// Unit rotation axis (world frame).
     pub axis: Vec3,
@@ -76,6 +75,24 @@ pub struct Shake {
     pub amplitude: Real,
     /// Frequency, Hz.
     pub frequency: Real,
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Shake {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Shake {{ axis: [{}, {}, {}], centre: [{}, {}, {}], amplitude: {}, frequency: {} }}",
+            self.axis.x,
+            self.axis.y,
+            self.axis.z,
+            self.centre.x,
+            self.centre.y,
+            self.centre.z,
+            self.amplitude,
+            self.frequency
+        )
+    }
 }
 
 impl Shake {

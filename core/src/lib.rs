@@ -41,7 +41,7 @@ pub use effects::{Effect, Effects};
 pub use error::{BuildError, CapacityError, Error, ParamError};
 pub use grab::{Grab, GrabStatus};
 pub use head::{Pose, Shake};
-pub use math::{DefaultMath, Libm, Math, Real, Vec3};
+pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
 pub use params::{Mode, Params, Solver};
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};

@@ -94,6 +94,18 @@ pub type DefaultMath = Libm;
 #[cfg(feature = "fast-math")]
 pub type DefaultMath = FastMath;
 
+/// A `Vec3` formatted for defmt as `[x, y, z]` (glam does not implement `defmt::Format`).
+#[cfg(feature = "defmt")]
+#[derive(Clone, Copy)]
+pub struct DefmtVec3(pub Vec3);
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for DefmtVec3 {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(f, "[{}, {}, {}]", self.0.x, self.0.y, self.0.z)
+    }
+}
+
 /// `true` when every component of `v` is finite.
 #[inline(always)]
 pub fn is_finite(v: Vec3) -> bool {

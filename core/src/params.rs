@@ -84,7 +84,6 @@ pub struct DftlParams {
 
 /// Everything a world needs to know besides its strands, colliders and grabs.
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Params {
     /// The model.
     pub solver: Solver,
@@ -171,7 +170,11 @@ impl Params {
             "dftl.global_shape",
             "0 to 1",
         )?;
-        range(fraction(self.dftl.local_shape), "dftl.local_shape", "0 to 1")?;
+        range(
+            fraction(self.dftl.local_shape),
+            "dftl.local_shape",
+            "0 to 1",
+        )?;
         range(
             self.dftl.reference_dt.is_finite() && self.dftl.reference_dt > 0.0,
             "dftl.reference_dt",
@@ -191,6 +194,26 @@ impl Params {
             });
         }
         Ok(())
+    }
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Params {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "Params {{ solver: {}, dt: {}, effects: {}, mode: {}, gravity: [{}, {}, {}], drag: {}, rod: {}, dftl: {} }}",
+            self.solver,
+            self.dt,
+            self.effects,
+            self.mode,
+            self.gravity.x,
+            self.gravity.y,
+            self.gravity.z,
+            self.drag,
+            self.rod,
+            self.dftl
+        )
     }
 }
 
@@ -229,7 +252,10 @@ mod tests {
         };
         assert!(matches!(
             shape_on_rod.validate(),
-            Err(ParamError::UnsupportedEffect { effect: "shape", .. })
+            Err(ParamError::UnsupportedEffect {
+                effect: "shape",
+                ..
+            })
         ));
     }
 }

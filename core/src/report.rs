@@ -142,6 +142,25 @@ impl Default for StepReport {
     }
 }
 
+#[cfg(feature = "defmt")]
+impl defmt::Format for StepReport {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "StepReport {{ flags: {}, iterations_max: {}, cap_hits: {}, residual: {}, max_stretch: {}, max_penetration: {}, contacts: {}, rolled_back: {}, grabs_slipped: {} }}",
+            self.flags,
+            self.iterations_max,
+            self.cap_hits,
+            self.residual,
+            self.max_stretch,
+            self.max_penetration,
+            self.contacts,
+            self.rolled_back,
+            self.grabs_slipped
+        )
+    }
+}
+
 impl StepReport {
     /// Counts one strand through `stage`.
     #[inline(always)]

@@ -55,7 +55,10 @@ pub mod firmware {
                 let bend = Vec3::new(0.002 * (i * i) as Real, 0.0, 0.0);
                 *p = root + direction * (0.01 * i as Real) + bend;
             }
-            world.add_strand(Strand::from_polyline(&points[..nodes], &Material::HUMAN_HAIR)?)?;
+            world.add_strand(Strand::from_polyline(
+                &points[..nodes],
+                &Material::HUMAN_HAIR,
+            )?)?;
         }
         Ok(())
     }

@@ -82,7 +82,11 @@ impl Material {
             "radius",
             "0 < r <= 0.01 m",
         )?;
-        check(positive(self.density), "density", "a finite value > 0 kg/m3")?;
+        check(
+            positive(self.density),
+            "density",
+            "a finite value > 0 kg/m3",
+        )?;
         check(
             self.minor_axis_penalty.is_finite() && (1.0..=100.0).contains(&self.minor_axis_penalty),
             "minor_axis_penalty",
@@ -173,7 +177,7 @@ impl<const N: usize> Strand<N> {
         for j in 0..nodes - 1 {
             let e = points[j + 1] - points[j];
             let length = Libm::length(e);
-            if !(length >= MIN_SEGMENT_LENGTH) {
+            if !length.is_finite() || length < MIN_SEGMENT_LENGTH {
                 return Err(BuildError::DegenerateSegment { segment: j });
             }
             if j > 0 {
@@ -307,6 +311,12 @@ mod tests {
             ..Material::HUMAN_HAIR
         };
         let e = Strand::<8>::from_polyline(&p[..4], &soft).unwrap_err();
-        assert!(matches!(e, BuildError::InvalidMaterial { field: "radius", .. }));
+        assert!(matches!(
+            e,
+            BuildError::InvalidMaterial {
+                field: "radius",
+                ..
+            }
+        ));
     }
 }

@@ -46,13 +46,9 @@ pub fn step_strands<M: Math, const N: usize>(
         let last_good = strand.state.clone();
         // 2. The solver's own stage list (Kmoch Alg. 1 or Sánchez-Banderas Alg. 1).
         match ctx.params.solver {
-            Solver::Rod => crate::rod::step::step::<M, N>(
-                strand,
-                ctx,
-                grabs,
-                strand_accelerations,
-                report,
-            ),
+            Solver::Rod => {
+                crate::rod::step::step::<M, N>(strand, ctx, grabs, strand_accelerations, report)
+            }
             // Refused by `Params::validate` until the DFTL solver lands.
             Solver::Dftl => {}
         }
@@ -145,7 +141,11 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub fn add_grab(&mut self, grab: Grab) -> Result<usize, Error> {
         let strand = self.strands.get(grab.strand as usize);
         let node_ok = strand.is_some_and(|s| grab.node >= 2 && (grab.node as usize) < s.nodes());
-        if !node_ok || !crate::math::is_finite(grab.target) || !(grab.force_limit > 0.0) {
+        if !node_ok
+            || !crate::math::is_finite(grab.target)
+            || grab.force_limit.is_nan()
+            || grab.force_limit <= 0.0
+        {
             return Err(ParamError::OutOfRange {
                 field: "grab",
                 allowed: "an existing strand, a node from 2 to its last, a finite target, force_limit > 0",
@@ -280,7 +280,11 @@ mod tests {
         assert_eq!(s.state.position[1], Vec3::new(0.01, 0.0, 0.0));
         // Symplectic Euler: y_k = −g h² k(k+1)/2 after k steps.
         let expected = -9.81 * 1e-6 * 100.0 * 101.0 / 2.0;
-        assert!((s.state.position[5].y - expected).abs() < 1e-5, "{}", s.state.position[5].y);
+        assert!(
+            (s.state.position[5].y - expected).abs() < 1e-5,
+            "{}",
+            s.state.position[5].y
+        );
     }
 
     #[test]

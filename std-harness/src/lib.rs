@@ -9,6 +9,7 @@ pub mod export;
 pub mod hairfile;
 pub mod picture;
 pub mod run;
+pub mod sph;
 pub mod summary;
 
 pub use hairsim_core as core;

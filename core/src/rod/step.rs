@@ -50,7 +50,11 @@ fn external_forces_and_integrate<const N: usize>(
 
 /// Root coupling: nodes 0 and 1 are prescribed by the head's rigid motion; their velocity is
 /// the position change over the step.
-fn root_coupling<const N: usize>(strand: &mut Strand<N>, ctx: &StepContext, report: &mut StepReport) {
+fn root_coupling<const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    report: &mut StepReport,
+) {
     report.ran(Stage::RootCoupling);
     for i in 0..2 {
         let target = ctx.head.transform_point(strand.rest.position[i]);

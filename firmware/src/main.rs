@@ -1,0 +1,122 @@
+//! hairsim's firmware example: a `World` in a `static`, stepped on a Cortex-M4F.
+//!
+//! Builds the scene `hairsim_core::scenes::firmware` (the harness runs the same scene as
+//! `hairsim run firmware`), steps it, and prints the state hash over semihosting. CI runs it
+//! under `qemu-system-arm -machine mps2-an386` and checks the hash equals the host's.
+#![no_std]
+#![no_main]
+
+use core::cell::RefCell;
+
+use cortex_m::interrupt::Mutex;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hprintln};
+use hairsim_core::scenes::firmware;
+use hairsim_core::{Libm, Math, Real, World};
+
+/// The math backend of this firmware: the FPU's `VSQRT` for square roots, `libm` (or, with the
+/// `fast-math` feature, the core's default) for trigonometry.
+///
+/// IEEE 754 requires `squareRoot` to be correctly rounded, and so is `libm::sqrtf`: the two give
+/// the same bits, `VSQRT` in 14 cycles instead of a software routine.
+#[derive(Clone, Copy, Default)]
+struct Vsqrt;
+
+impl Math for Vsqrt {
+    const NAME: &'static str = "vsqrt+libm";
+
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        let bits: u32;
+        // SAFETY: VSQRT.F32 on S15, saved and restored around it, so no register the compiler
+        // uses changes. (Rust's `sreg` operand class needs the double-precision `vfp2` feature,
+        // which a Cortex-M4F does not have, hence the explicit register and core-register moves.)
+        unsafe {
+            core::arch::asm!(
+                "vpush {{s15}}",
+                "vmov s15, {x}",
+                "vsqrt.f32 s15, s15",
+                "vmov {r}, s15",
+                "vpop {{s15}}",
+                x = in(reg) x.to_bits(),
+                r = lateout(reg) bits,
+                options(preserves_flags),
+            );
+        }
+        Real::from_bits(bits)
+    }
+
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        <hairsim_core::DefaultMath as Math>::sin_cos(x)
+    }
+
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        <hairsim_core::DefaultMath as Math>::atan2(y, x)
+    }
+}
+
+type FirmwareWorld = World<{ firmware::STRANDS }, { firmware::NODES }, Vsqrt>;
+
+/// The world lives in a `static`: no heap, its size known at link time.
+static WORLD: Mutex<RefCell<FirmwareWorld>> = Mutex::new(RefCell::new(World::new()));
+
+#[entry]
+fn main() -> ! {
+    let code = cortex_m::interrupt::free(|cs| {
+        let mut world = WORLD.borrow(cs).borrow_mut();
+        run(&mut world)
+    });
+    debug::exit(code);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
+
+fn run(world: &mut FirmwareWorld) -> debug::ExitStatus {
+    if !sqrt_matches_libm() {
+        hprintln!("error: VSQRT and libm::sqrtf disagree");
+        return debug::EXIT_FAILURE;
+    }
+    match firmware::run(world, firmware::STEPS) {
+        Ok(hash) => {
+            let finite = world.strands().iter().all(|s| s.is_finite());
+            hprintln!(
+                "scene firmware steps {} strands {} finite {} state_hash 0x{:016x}",
+                world.steps(),
+                world.strands().len(),
+                finite,
+                hash
+            );
+            if finite {
+                debug::EXIT_SUCCESS
+            } else {
+                debug::EXIT_FAILURE
+            }
+        }
+        Err(e) => {
+            hprintln!("error: building the firmware scene: {}", e);
+            debug::EXIT_FAILURE
+        }
+    }
+}
+
+/// The backend's promise, checked on the target itself: `VSQRT` gives `libm`'s bits.
+fn sqrt_matches_libm() -> bool {
+    let mut x: f32 = 1.0e-20;
+    while x < 1.0e20 {
+        if Vsqrt::sqrt(x).to_bits() != Libm::sqrt(x).to_bits() {
+            return false;
+        }
+        x *= 1.013;
+    }
+    true
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    hprintln!("panic: {}", info);
+    debug::exit(debug::EXIT_FAILURE);
+    #[allow(clippy::empty_loop)]
+    loop {}
+}
