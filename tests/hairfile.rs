@@ -15,6 +15,8 @@ use hairsim::export::{
 use hairsim::hairfile::{
     polyline_length, read_hair, read_tfx, HairFileError, HairModel, ReadOptions, UpAxis,
 };
+use hairsim_core::scenes::firmware;
+use hairsim_core::{Libm, World};
 
 /// Counts the bytes live on the current thread while tracking is on, and their peak. Per
 /// thread, because the test harness runs tests in parallel in one process.
@@ -65,8 +67,9 @@ unsafe impl GlobalAlloc for CountingAllocator {
         unsafe { System.alloc_zeroed(layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        on_free(layout.size());
+        // New block first: during a move both are live, and the peak must see that.
         on_alloc(new_size);
+        on_free(layout.size());
         // SAFETY: same contract as ours.
         unsafe { System.realloc(ptr, layout, new_size) }
     }
@@ -612,4 +615,93 @@ fn mutated_seeds_never_panic_or_over_allocate() {
         refused > 1000,
         "only {refused} of 4000 mutated files refused"
     );
+}
+
+/// The GIF writer streams: its peak memory does not grow with the number of frames.
+#[test]
+fn gif_writer_memory_does_not_grow_with_frames() {
+    use hairsim::picture::{Camera, GifWriter, Style, View};
+    let strands = wavy(20, |_| 12);
+    let camera = Camera::fit_reach(&strands, &[], View::Front, 96, 96);
+    let peak_for = |frames: usize| {
+        peak_of(|| {
+            let mut gif = GifWriter::new(std::io::sink(), camera, Style::default(), 4).unwrap();
+            for k in 0..frames {
+                let mut s = strands.clone();
+                s.iter_mut().flatten().for_each(|p| p.x += 0.001 * k as f32);
+                gif.add_frame(&s, &[]).unwrap();
+            }
+            gif.finish().unwrap();
+        })
+        .1
+    };
+    let (two, twenty) = (peak_for(2), peak_for(20));
+    assert!(
+        twenty <= two + two / 10,
+        "peak {twenty} bytes for 20 frames vs {two} for 2"
+    );
+}
+
+type FirmwareWorld = World<{ firmware::STRANDS }, { firmware::NODES }, Libm>;
+
+/// A frame as `OutDir` takes it: strand positions borrowed from the world, colliders in world
+/// coordinates (head-attached ones moved by the head's pose).
+fn frame(world: &FirmwareWorld) -> (Vec<&[Vec3]>, Vec<hairsim_core::Shape>) {
+    let strands = world.strands().iter().map(|s| s.positions()).collect();
+    let head = world.head();
+    let colliders = world
+        .colliders()
+        .iter()
+        .map(|c| {
+            if c.attached_to_head {
+                c.shape.transformed(&head)
+            } else {
+                c.shape
+            }
+        })
+        .collect();
+    (strands, colliders)
+}
+
+/// The glue `hairsim run --out DIR` needs, on the firmware scene: strands straight from the
+/// core's `World`, head-attached colliders moved by the head's pose, frames every 100 steps.
+/// Set `HAIRSIM_PICTURES=DIR` to keep the output for a look.
+#[test]
+fn a_core_world_run_goes_through_out_dir() {
+    use hairsim::export::{Format, OutDir, OutOptions};
+
+    let dir = std::env::var_os("HAIRSIM_PICTURES").map_or_else(
+        || std::env::temp_dir().join(format!("hairsim-run-out-{}", std::process::id())),
+        PathBuf::from,
+    );
+    let mut world: Box<FirmwareWorld> = Box::default();
+    firmware::build(&mut world).unwrap();
+    let options = OutOptions {
+        frame_formats: vec![Format::Obj, Format::Usda],
+        ..OutOptions::default()
+    };
+    let mut out = OutDir::create(&dir, options).unwrap();
+    for k in 0..300 {
+        if k % 100 == 0 {
+            let (strands, colliders) = frame(&world);
+            out.frame(world.steps(), &strands, &colliders).unwrap();
+        }
+        world.step(&firmware::input::<Libm>(k));
+    }
+    let (strands, colliders) = frame(&world);
+    let written = out.finish(&strands, &colliders).unwrap();
+    // 3 frames × 2 formats, run.gif, final.obj, final.png.
+    assert_eq!(written.len(), 3 * 2 + 3, "{written:?}");
+    let text = std::fs::read_to_string(dir.join("final.obj")).unwrap();
+    let back = read_obj(&text).unwrap();
+    assert_eq!(back.len(), firmware::STRANDS);
+    assert!(colliders.len() == 1);
+    for (a, b) in back.iter().zip(&strands) {
+        assert_eq!(a.as_slice(), *b);
+    }
+    let png = std::fs::read(dir.join("final.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    if std::env::var_os("HAIRSIM_PICTURES").is_none() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

@@ -20,6 +20,11 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+// Unit tests print the figures they measure and use std's float functions; the library never
+// links std.
+#[cfg(test)]
+extern crate std; // cfg(test) only
+
 pub mod collide;
 pub mod context;
 pub mod dftl;
@@ -27,12 +32,15 @@ pub mod effects;
 pub mod error;
 pub mod follow;
 pub mod forces;
+pub mod frames;
 pub mod grab;
 pub mod guard;
 pub mod hash;
 pub mod head;
 pub mod math;
 pub mod params;
+pub mod precision;
+pub mod projection;
 pub mod report;
 pub mod rod;
 pub mod scenes;
@@ -46,6 +54,7 @@ pub use grab::{Grab, GrabStatus};
 pub use head::{Pose, Shake};
 pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
 pub use params::{DftlCoefficients, DftlParams, Mode, Params, Solver, WindParams};
+pub use projection::project_constraints;
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};
 pub use world::{step_strands, StepInput, World};

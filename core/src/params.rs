@@ -3,6 +3,7 @@
 use crate::effects::{Effect, Effects};
 use crate::error::ParamError;
 use crate::math::{Real, Vec3};
+pub use crate::rod::twist::TwistMethod;
 
 /// Which model steps the strands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -67,6 +68,13 @@ pub struct RodParams {
     pub projection_iterations: u16,
     /// Relative tolerance `max |e·e − ê·ê| / ê·ê`. Default 1e-6.
     pub projection_tolerance: Real,
+    /// The quasistatic twist (`twist` effect): hair-optimised (Sec. 6.2) or Newton (BWR08).
+    /// Default hair-optimised.
+    pub twist: TwistMethod,
+    /// Iteration cap of the Newton twist. Default 10.
+    pub newton_iterations: u16,
+    /// Newton twist tolerance on the largest angle update, rad. Default 1e-6.
+    pub newton_tolerance: Real,
 }
 
 /// Parameters of the DFTL solver (Sánchez-Banderas 2015, Sec. 3.1).
@@ -180,6 +188,9 @@ impl Params {
         rod: RodParams {
             projection_iterations: 8,
             projection_tolerance: 1.0e-6,
+            twist: TwistMethod::HairOptimised,
+            newton_iterations: 10,
+            newton_tolerance: 1.0e-6,
         },
         dftl: DftlParams {
             damping: 0.9,
@@ -231,6 +242,16 @@ impl Params {
             self.rod.projection_tolerance.is_finite() && self.rod.projection_tolerance > 0.0,
             "rod.projection_tolerance",
             "a finite value > 0",
+        )?;
+        range(
+            self.rod.newton_iterations >= 1 && self.rod.newton_iterations <= 100,
+            "rod.newton_iterations",
+            "1 to 100",
+        )?;
+        range(
+            self.rod.newton_tolerance.is_finite() && self.rod.newton_tolerance > 0.0,
+            "rod.newton_tolerance",
+            "a finite value > 0 rad",
         )?;
         let fraction = |v: Real| v.is_finite() && (0.0..=1.0).contains(&v);
         range(fraction(self.dftl.damping), "dftl.damping", "0 to 1")?;
@@ -359,6 +380,17 @@ mod tests {
             ..Params::DEFAULT
         };
         assert!(sideways.validate().is_err());
+        let mut newton = Params::DEFAULT;
+        newton.rod.twist = TwistMethod::Newton;
+        assert_eq!(newton.validate(), Ok(()));
+        newton.rod.newton_iterations = 0;
+        assert!(matches!(
+            newton.validate(),
+            Err(ParamError::OutOfRange {
+                field: "rod.newton_iterations",
+                ..
+            })
+        ));
         let shape_on_rod = Params {
             effects: Effects::NONE.with(Effect::Shape),
             ..Params::DEFAULT

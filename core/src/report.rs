@@ -59,7 +59,8 @@ pub const NAMED_STRANDS: usize = 8;
 pub struct Flags(u16);
 
 impl Flags {
-    /// An iteration cap was hit before the tolerance was reached.
+    /// An iteration cap was hit before the tolerance was reached (or, where coarser, what f32
+    /// positions can resolve).
     pub const CAP_HIT: Flags = Flags(1);
     /// A strand turned non-finite and was rolled back.
     pub const ROLLED_BACK: Flags = Flags(2);
@@ -68,6 +69,12 @@ impl Flags {
     /// The caller's input (head pose, accelerations, grab targets) held a non-finite value,
     /// which was ignored.
     pub const BAD_INPUT: Flags = Flags(8);
+    /// The projection met dependent constraints (a singular or near-singular pivot, or a
+    /// non-finite multiplier) and solved without those rows; see `StepReport::dropped_rows`.
+    pub const SINGULAR: Flags = Flags(16);
+    /// A node was inside more colliders than it can carry collision rows for
+    /// (`projection::constraints::MAX_NODE_CONTACTS`); the extra contacts waited an iteration.
+    pub const CONTACTS_TRUNCATED: Flags = Flags(32);
 
     /// Whether every flag of `other` is set.
     #[must_use]
@@ -98,25 +105,30 @@ pub struct StepReport {
     pub iterations_total: u32,
     /// Strands whose projection hit its iteration cap above tolerance.
     pub cap_hits: u32,
-    /// Largest final projection residual `max |e·e − ê·ê| / ê·ê` over strands.
+    /// Largest final projection residual over strands: `max |e·e − ê·ê| / ê·ê` over segments
+    /// and `depth / |ê|` over nodes still inside a collider.
     pub residual: Real,
+    /// Constraint rows the projection dropped at a singular pivot, summed over iterations and
+    /// strands (see [`Flags::SINGULAR`]).
+    pub dropped_rows: u32,
     /// Largest relative stretch `| |e| − |ê| | / |ê|` of a segment without contact.
     pub max_stretch: Real,
     /// Largest relative stretch of a segment with a node pushed out of a collider.
     pub max_contact_stretch: Real,
     /// Deepest node inside a collider after the step, m.
     pub max_penetration: Real,
-    /// Nodes in contact after the step (high-water mark per step).
+    /// Nodes that got a collision row in this step's projection (pushed out of a collider).
     pub contacts: u32,
     /// Strands rolled back to their last good state.
     pub rolled_back: u32,
     /// The first [`NAMED_STRANDS`] rolled-back strands, by index.
     pub rolled_back_strands: heapless::Vec<u32, NAMED_STRANDS>,
-    /// Force each grab's device feels, N (zero for unused slots).
+    /// Force each grab's device feels, N (zero for unused slots): the pull of the strand on the
+    /// held node plus the node's own weight and inertia (at rest: the weight held).
     pub grab_forces: [Vec3; MAX_GRABS],
     /// Grabs that slipped this step (bit `g` for grab `g`).
     pub grabs_slipped: u8,
-    /// Total contact force on each collider, N.
+    /// Total contact force the hair exerts on each collider, N (from the collision multipliers).
     pub collider_forces: [Vec3; MAX_COLLIDERS],
 }
 
@@ -129,6 +141,7 @@ impl Default for StepReport {
             iterations_total: 0,
             cap_hits: 0,
             residual: 0.0,
+            dropped_rows: 0,
             max_stretch: 0.0,
             max_contact_stretch: 0.0,
             max_penetration: 0.0,
@@ -147,11 +160,12 @@ impl defmt::Format for StepReport {
     fn format(&self, f: defmt::Formatter) {
         defmt::write!(
             f,
-            "StepReport {{ flags: {}, iterations_max: {}, cap_hits: {}, residual: {}, max_stretch: {}, max_penetration: {}, contacts: {}, rolled_back: {}, grabs_slipped: {} }}",
+            "StepReport {{ flags: {}, iterations_max: {}, cap_hits: {}, residual: {}, dropped_rows: {}, max_stretch: {}, max_penetration: {}, contacts: {}, rolled_back: {}, grabs_slipped: {} }}",
             self.flags,
             self.iterations_max,
             self.cap_hits,
             self.residual,
+            self.dropped_rows,
             self.max_stretch,
             self.max_penetration,
             self.contacts,
@@ -194,6 +208,7 @@ impl StepReport {
         self.iterations_total += other.iterations_total;
         self.cap_hits += other.cap_hits;
         self.residual = self.residual.max(other.residual);
+        self.dropped_rows += other.dropped_rows;
         self.max_stretch = self.max_stretch.max(other.max_stretch);
         self.max_contact_stretch = self.max_contact_stretch.max(other.max_contact_stretch);
         self.max_penetration = self.max_penetration.max(other.max_penetration);

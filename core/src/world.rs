@@ -46,9 +46,14 @@ pub fn step_strands<M: Math, const N: usize>(
         let last_good = strand.state.clone();
         // 2. The solver's own stage list (Kmoch Alg. 1 or Sánchez-Banderas Alg. 1).
         match ctx.params.solver {
-            Solver::Rod => {
-                crate::rod::step::step::<M, N>(strand, ctx, grabs, strand_accelerations, report)
-            }
+            Solver::Rod => crate::rod::step::step::<M, N>(
+                strand,
+                ctx,
+                grabs,
+                index,
+                strand_accelerations,
+                report,
+            ),
             Solver::Dftl => crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report),
         }
         // 3. Guard: nothing non-finite leaves the step.

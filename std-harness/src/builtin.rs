@@ -32,7 +32,7 @@ pub const DEFAULT_SCENE: &str = "firmware";
 pub const BUILTINS: &[Builtin] = &[
     Builtin {
         name: "firmware",
-        about: "the firmware example's scene: 4 rod strands of 12-15 nodes on a 5 cm head shaking at 10 rad/s, 1000 steps at 1 ms (same hash as under QEMU)",
+        about: "the firmware example's scene: 4 rod strands of 12-15 nodes on a 5 cm head shaking at 10 rad/s, one tip grabbed on a circle, every rod stage on, 1000 steps at 1 ms (same hash as under QEMU)",
         scene: firmware_scene,
     },
     Builtin {
@@ -171,7 +171,26 @@ pub fn firmware_scene() -> Scene {
     // The firmware scene is fixed and valid; a failure here would leave the world empty and the
     // scene would be refused by its check ("no strands"), never run half-built.
     let _ = firmware::build(&mut world);
-    from_world("firmware", &world, u64::from(firmware::STEPS))
+    let mut scene = from_world("firmware", &world, u64::from(firmware::STEPS));
+    // `firmware::grab_target`: a 1 cm circle at 2 Hz in the x–z plane from the tip's rest
+    // position (the target before step k is the circle at t = (k + 1) dt, as here).
+    if let Some(grab) = world.grabs().first() {
+        scene.grabs = vec![GrabSpec {
+            strand: grab.strand,
+            node: grab.node,
+            force_limit: grab.force_limit,
+            path: None,
+            circle: Some(crate::scene::CircleSpec {
+                start: grab.target.to_array(),
+                radius: 0.01,
+                frequency: 2.0,
+                u: None,
+                v: None,
+            }),
+            release: None,
+        }];
+    }
+    scene
 }
 
 /// The firmware's DFTL scene, from `hairsim_core::scenes::firmware_dftl`.
@@ -381,7 +400,7 @@ fn haptic() -> Scene {
         strand: 0,
         node: grabbed,
         force_limit: 0.05,
-        path: vec![
+        path: Some(vec![
             PathKey {
                 time: 0.0,
                 target: start,
@@ -394,7 +413,8 @@ fn haptic() -> Scene {
                 time: 2.0,
                 target: start,
             },
-        ],
+        ]),
+        circle: None,
         release: None,
     }];
     scene

@@ -39,7 +39,11 @@ pub fn scene_inputs<M: Math>(prepared: &Prepared, k: u64) -> StepInputs {
     let t = time_after(k, prepared.params.dt);
     StepInputs {
         head: prepared.motion.pose_at::<M>(t),
-        grab_targets: prepared.grabs.iter().map(|g| g.path.target_at(t)).collect(),
+        grab_targets: prepared
+            .grabs
+            .iter()
+            .map(|g| g.path.target_at::<M>(t))
+            .collect(),
         released: prepared
             .grabs
             .iter()
@@ -88,7 +92,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
         let grabs = prepared
             .grabs
             .iter()
-            .map(|g| Grab::new(g.strand, g.node, g.path.target_at(0.0), g.force_limit))
+            .map(|g| Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit))
             .collect();
         let pool = if threads > 1 {
             Some(

@@ -21,6 +21,9 @@ pub fn write_hair<W: Write, S: AsRef<[Vec3]>>(
 ) -> Result<(), ExportError> {
     use crate::hairfile::yuksel_bits::{HAS_POINTS, HAS_SEGMENTS};
     check_strands(strands)?;
+    if !(width.is_finite() && width >= 0.0) {
+        return Err(ExportError::BadWidth(width));
+    }
     let max = usize::from(u16::MAX) + 1;
     for (strand, s) in strands.iter().enumerate() {
         let points = s.as_ref().len();

@@ -84,6 +84,9 @@ pub enum ExportError {
         /// Strand 0's.
         first: usize,
     },
+    /// A strand width that is negative or not finite.
+    #[error("bad strand width {0}: must be finite and >= 0")]
+    BadWidth(f32),
     /// The path's extension names no format.
     #[error("{0}: unknown extension (expected .obj, .ply, .hair, .usda or .tfx)")]
     UnknownExtension(String),
@@ -178,6 +181,20 @@ impl Format {
     }
 }
 
+impl std::str::FromStr for Format {
+    type Err = String;
+
+    /// An extension without the dot (`obj`, `ply`, `hair`, `usda`, `tfx`), any case, for
+    /// command-line options such as `--frames obj,usda`.
+    fn from_str(name: &str) -> Result<Format, String> {
+        let name = name.trim_start_matches('.').to_ascii_lowercase();
+        Format::ALL
+            .into_iter()
+            .find(|f| f.extension() == name)
+            .ok_or_else(|| format!("unknown format {name:?} (obj, ply, hair, usda or tfx)"))
+    }
+}
+
 /// Writes `strands` to `path` in the format its extension names, with [`DEFAULT_WIDTH`].
 ///
 /// # Errors
@@ -234,6 +251,27 @@ pub(crate) fn parse_coordinate(
         ));
     }
     Ok(value)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_and_views_parse_from_their_names() {
+        for f in Format::ALL {
+            assert_eq!(f.extension().parse::<Format>(), Ok(f));
+            assert_eq!(
+                Format::from_path(Path::new(&format!("a/b.{}", f.extension()))),
+                Some(f)
+            );
+        }
+        assert_eq!(".USDA".parse::<Format>(), Ok(Format::Usda));
+        assert!("abc".parse::<Format>().is_err());
+        use crate::picture::View;
+        assert_eq!("Side".parse::<View>(), Ok(View::Side));
+        assert!("diagonal".parse::<View>().is_err());
+    }
 }
 
 #[cfg(test)]

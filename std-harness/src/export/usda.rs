@@ -18,6 +18,9 @@ pub fn write_usda<W: Write, S: AsRef<[Vec3]>>(
     width: f32,
 ) -> Result<(), ExportError> {
     check_strands(strands)?;
+    if !(width.is_finite() && width >= 0.0) {
+        return Err(ExportError::BadWidth(width));
+    }
     let mut out = BufWriter::new(out);
     writeln!(out, "#usda 1.0")?;
     writeln!(out, "(")?;
@@ -31,6 +34,20 @@ pub fn write_usda<W: Write, S: AsRef<[Vec3]>>(
     writeln!(out, "{{")?;
     writeln!(out, "    uniform token type = \"linear\"")?;
     writeln!(out, "    uniform token wrap = \"nonperiodic\"")?;
+    // Bounds of the curves swept by their width, which USD asks of every boundable prim.
+    if let Some((lo, hi)) = crate::hairfile::bounds_of(strands) {
+        let (lo, hi) = (lo - Vec3::splat(0.5 * width), hi + Vec3::splat(0.5 * width));
+        writeln!(
+            out,
+            "    float3[] extent = [({}, {}, {}), ({}, {}, {})]",
+            Num(lo.x),
+            Num(lo.y),
+            Num(lo.z),
+            Num(hi.x),
+            Num(hi.y),
+            Num(hi.z)
+        )?;
+    }
     write!(out, "    int[] curveVertexCounts = [")?;
     for (i, s) in strands.iter().enumerate() {
         let sep = if i == 0 { "" } else { ", " };
@@ -88,19 +105,13 @@ pub fn read_usda(text: &str) -> Result<Vec<Vec<Vec3>>, TextReadError> {
             .find(')')
             .ok_or_else(|| TextReadError::new(F, line_of(rest), "unclosed point"))?;
         let tuple = &rest[open + 1..open + close];
-        let mut c = tuple.split(',').map(str::trim);
-        let line = line_of(tuple);
-        let x = super::parse_coordinate(F, line, c.next())?;
-        let y = super::parse_coordinate(F, line, c.next())?;
-        let z = super::parse_coordinate(F, line, c.next())?;
-        if c.next().is_some() {
-            return Err(TextReadError::new(
-                F,
-                line,
-                "point with more than 3 coordinates",
-            ));
-        }
-        points.push(Vec3::new(x, y, z));
+        // The line number is counted only on error: counting it for every point would make
+        // reading quadratic in the file's size.
+        let point = parse_point(tuple).map_err(|mut e| {
+            e.line = line_of(tuple);
+            e
+        })?;
+        points.push(point);
         rest = &rest[open + close + 1..];
     }
     let total = counts.iter().try_fold(0usize, |a, &n| a.checked_add(n));
@@ -121,6 +132,22 @@ pub fn read_usda(text: &str) -> Result<Vec<Vec<Vec3>>, TextReadError> {
         at += n;
     }
     Ok(strands)
+}
+
+/// `x, y, z` (line 0: the caller fills it in).
+fn parse_point(tuple: &str) -> Result<Vec3, TextReadError> {
+    let mut c = tuple.split(',').map(str::trim);
+    let x = super::parse_coordinate("USDA", 0, c.next())?;
+    let y = super::parse_coordinate("USDA", 0, c.next())?;
+    let z = super::parse_coordinate("USDA", 0, c.next())?;
+    if c.next().is_some() {
+        return Err(TextReadError::new(
+            "USDA",
+            0,
+            "point with more than 3 coordinates",
+        ));
+    }
+    Ok(Vec3::new(x, y, z))
 }
 
 /// The text between the brackets of `name … = [ … ]`.
@@ -159,6 +186,11 @@ mod tests {
         assert!(text.contains("int[] curveVertexCounts = [3, 2, 40]"));
         assert!(text.contains("uniform token type = \"linear\""));
         assert!(text.contains("float[] widths = [8e-5]"));
+        assert!(text.contains("float3[] extent = [("));
+        assert!(matches!(
+            write_usda(Vec::new(), &strands, f32::NAN),
+            Err(ExportError::BadWidth(_))
+        ));
         assert_same_bits(&read_usda(&text).unwrap(), &strands);
     }
 
@@ -169,6 +201,6 @@ mod tests {
         assert!(e.message.contains("add up"), "{e}");
         assert!(read_usda("point3f[] points = [(0, 0, 0)]").is_err());
         let nan = "int[] curveVertexCounts = [2]\npoint3f[] points = [(0, 0, 0), (nan, 0, 0)]\n";
-        assert!(read_usda(nan).is_err());
+        assert_eq!(read_usda(nan).unwrap_err().line, 2);
     }
 }

@@ -32,6 +32,21 @@ impl View {
     }
 }
 
+impl std::str::FromStr for View {
+    type Err = String;
+
+    /// `front`, `back`, `side` or `top` (for command-line options).
+    fn from_str(name: &str) -> Result<View, String> {
+        match name.to_ascii_lowercase().as_str() {
+            "front" => Ok(View::Front),
+            "back" => Ok(View::Back),
+            "side" => Ok(View::Side),
+            "top" => Ok(View::Top),
+            _ => Err(format!("unknown view {name:?} (front, back, side or top)")),
+        }
+    }
+}
+
 /// An orthographic camera and the picture's size.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {

@@ -14,7 +14,7 @@ use tiny_skia::{
     Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Point, Stroke, Transform,
 };
 
-pub use camera::{Camera, View};
+pub use camera::{Camera, View, MARGIN};
 pub use gif_writer::GifWriter;
 
 /// Why a picture could not be made.

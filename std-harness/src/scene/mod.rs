@@ -413,11 +413,35 @@ pub struct GrabSpec {
     pub node: u32,
     /// Force at which the grab slips, N.
     pub force_limit: f32,
-    /// Target path: keys in increasing time, linear between them, held after the last.
-    pub path: Vec<PathKey>,
+    /// Target path: keys in increasing time, linear between them, held after the last (give
+    /// this or `circle`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<Vec<PathKey>>,
+    /// A circular target path (give this or `path`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub circle: Option<CircleSpec>,
     /// Time the grab lets go, s (default never).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub release: Option<f32>,
+}
+
+/// A grab target going round a circle from `start`:
+/// `target(t) = start + u · r (cos 2πft − 1) + v · r sin 2πft`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CircleSpec {
+    /// Target at time 0, m (world frame).
+    pub start: V3,
+    /// Radius r, m.
+    pub radius: f32,
+    /// Turns per second f, Hz.
+    pub frequency: f32,
+    /// First axis of the circle's plane (default `[1, 0, 0]`; normalised).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub u: Option<V3>,
+    /// Second axis of the circle's plane (default `[0, 0, 1]`; normalised).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub v: Option<V3>,
 }
 
 /// One key of a grab path.

@@ -3,6 +3,8 @@
 //! transcendental goes through the math backend `M`, so inputs are the same bits on every
 //! target and thread count.
 
+use std::f32::consts::PI;
+
 use hairsim_core::math::{quat_from_axis_angle, quat_normalize, Quat};
 use hairsim_core::{Math, Pose, Real, Shake, Vec3};
 
@@ -75,30 +77,52 @@ fn keyframe_pose<M: Math>(keys: &[Key], t: Real) -> Pose {
     }
 }
 
+/// Where a grab's target goes.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Path {
+    /// `(time, target)` keys in increasing time, linear between them.
+    Keys(Vec<(Real, Vec3)>),
+    /// `start + u · r (cos 2πft − 1) + v · r sin 2πft`.
+    Circle {
+        /// Target at time 0.
+        start: Vec3,
+        /// r, m.
+        radius: Real,
+        /// f, Hz.
+        frequency: Real,
+        /// Unit axis.
+        u: Vec3,
+        /// Unit axis.
+        v: Vec3,
+    },
+}
+
 /// A grab's target path and release time.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GrabPath {
-    /// `(time, target)` keys in increasing time.
-    pub keys: Vec<(Real, Vec3)>,
+    /// The target's path.
+    pub path: Path,
     /// When the grab lets go, s.
     pub release: Option<Real>,
 }
 
 impl GrabPath {
-    /// The target at time `t`: linear between keys, held before the first and after the last.
+    /// The target at time `t`: keys are linear between them and held before the first and
+    /// after the last.
     #[must_use]
-    pub fn target_at(&self, t: Real) -> Vec3 {
-        let Some(&(_, first)) = self.keys.first() else {
-            return Vec3::ZERO;
-        };
-        match self.keys.iter().position(|k| k.0 > t) {
-            None => self.keys.last().map_or(first, |k| k.1),
-            Some(0) => first,
-            Some(i) => {
-                let (ta, a) = self.keys[i - 1];
-                let (tb, b) = self.keys[i];
-                let s = (t - ta) / (tb - ta);
-                a * (1.0 - s) + b * s
+    pub fn target_at<M: Math>(&self, t: Real) -> Vec3 {
+        match &self.path {
+            Path::Keys(keys) => keyed_target(keys, t),
+            Path::Circle {
+                start,
+                radius,
+                frequency,
+                u,
+                v,
+            } => {
+                // The firmware scene's own arithmetic, term by term, so its hash is kept.
+                let (s, c) = M::sin_cos(2.0 * PI * *frequency * t);
+                *start + *u * (*radius * (c - 1.0)) + *v * (*radius * s)
             }
         }
     }
@@ -107,6 +131,22 @@ impl GrabPath {
     #[must_use]
     pub fn released_at(&self, t: Real) -> bool {
         self.release.is_some_and(|r| t >= r)
+    }
+}
+
+fn keyed_target(keys: &[(Real, Vec3)], t: Real) -> Vec3 {
+    let Some(&(_, first)) = keys.first() else {
+        return Vec3::ZERO;
+    };
+    match keys.iter().position(|k| k.0 > t) {
+        None => keys.last().map_or(first, |k| k.1),
+        Some(0) => first,
+        Some(i) => {
+            let (ta, a) = keys[i - 1];
+            let (tb, b) = keys[i];
+            let s = (t - ta) / (tb - ta);
+            a * (1.0 - s) + b * s
+        }
     }
 }
 
@@ -143,12 +183,26 @@ mod tests {
     #[test]
     fn grab_paths_hold_at_the_ends() {
         let path = GrabPath {
-            keys: vec![(1.0, Vec3::ZERO), (2.0, Vec3::new(0.0, 2.0, 0.0))],
+            path: Path::Keys(vec![(1.0, Vec3::ZERO), (2.0, Vec3::new(0.0, 2.0, 0.0))]),
             release: Some(3.0),
         };
-        assert_eq!(path.target_at(0.0), Vec3::ZERO);
-        assert_eq!(path.target_at(1.5), Vec3::new(0.0, 1.0, 0.0));
-        assert_eq!(path.target_at(9.0), Vec3::new(0.0, 2.0, 0.0));
+        assert_eq!(path.target_at::<Libm>(0.0), Vec3::ZERO);
+        assert_eq!(path.target_at::<Libm>(1.5), Vec3::new(0.0, 1.0, 0.0));
+        assert_eq!(path.target_at::<Libm>(9.0), Vec3::new(0.0, 2.0, 0.0));
         assert!(!path.released_at(2.9) && path.released_at(3.0));
+        let circle = GrabPath {
+            path: Path::Circle {
+                start: Vec3::new(1.0, 2.0, 3.0),
+                radius: 0.5,
+                frequency: 2.0,
+                u: Vec3::X,
+                v: Vec3::Z,
+            },
+            release: None,
+        };
+        assert_eq!(circle.target_at::<Libm>(0.0), Vec3::new(1.0, 2.0, 3.0));
+        // A quarter turn: −r along u... plus r along v.
+        let q = circle.target_at::<Libm>(0.125);
+        assert!((q - Vec3::new(0.5, 2.0, 3.5)).length() < 1e-6, "{q}");
     }
 }

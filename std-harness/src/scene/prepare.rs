@@ -12,7 +12,7 @@ use hairsim_core::{
 
 use super::error::FieldError;
 use super::generate::{self, v3, Follower, Style};
-use super::motion::{GrabPath, Key, Motion};
+use super::motion::{GrabPath, Key, Motion, Path as TargetPath};
 use super::validate::{self, MAX_NODES};
 use super::{HairSpec, MaterialSpec, MotionSpec, Scene, StyleSpec};
 
@@ -386,7 +386,21 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
             node: g.node,
             force_limit: g.force_limit,
             path: GrabPath {
-                keys: g.path.iter().map(|k| (k.time, v3(k.target))).collect(),
+                path: match (&g.path, &g.circle) {
+                    (_, Some(c)) => TargetPath::Circle {
+                        start: v3(c.start),
+                        radius: c.radius,
+                        frequency: c.frequency,
+                        u: c.u.map_or(Vec3::X, unit),
+                        v: c.v.map_or(Vec3::Z, unit),
+                    },
+                    (path, None) => TargetPath::Keys(
+                        path.iter()
+                            .flatten()
+                            .map(|k| (k.time, v3(k.target)))
+                            .collect(),
+                    ),
+                },
                 release: g.release,
             },
         });

@@ -82,7 +82,7 @@ fn syntax_and_structure_errors() {
     refused(
         &[],
         "[[grabs]]\nstrand = 0\nnode = 3\nforce_limit = 1.0\n",
-        "t.toml:12: grabs[0].path: missing field `path`",
+        "t.toml:12: grabs[0].path: missing: give path (keys) or circle",
     );
 }
 
@@ -594,6 +594,42 @@ fn grab_wind_sph_and_output_errors() {
         "t.toml:32: grabs[4]: 5 grabs, allowed at most 4",
     );
     let wind = "[wind]\ndirection = [1.0, 0.0, 0.0]\nstrength = 2.0\n";
+    let circle = |body: &str| {
+        format!("[[grabs]]\nstrand = 0\nnode = 3\nforce_limit = 1.0\ncircle = {{ {body} }}\n")
+    };
+    refused(
+        &[],
+        &format!(
+            "{}path = []\n",
+            circle("start = [0.1, 0.0, 0.0], radius = 0.01, frequency = 2.0")
+        ),
+        "t.toml:16: grabs[0].circle: both path and circle are given, allowed one of them",
+    );
+    refused(
+        &[],
+        &circle("start = [0.1, 0.0, 1e3], radius = 0.01, frequency = 2.0"),
+        "t.toml:16: grabs[0].circle.start: [0.1, 0.0, 1000.0] is out of range",
+    );
+    refused(
+        &[],
+        &circle("start = [0.1, 0.0, 0.0], radius = 0.0, frequency = 2.0"),
+        "t.toml:16: grabs[0].circle.radius: 0 is out of range, allowed > 0 and <= 10 m",
+    );
+    refused(
+        &[],
+        &circle("start = [0.1, 0.0, 0.0], radius = 0.01, frequency = -2.0"),
+        "t.toml:16: grabs[0].circle.frequency: -2 is out of range, allowed 0 to 100 Hz",
+    );
+    refused(
+        &[],
+        &circle("start = [0.1, 0.0, 0.0], radius = 0.01, frequency = 2.0, u = [0.0, 0.0, 0.0]"),
+        "t.toml:16: grabs[0].circle.u: [0.0, 0.0, 0.0] is not a direction",
+    );
+    refused(
+        &[],
+        &circle("start = [0.1, 0.0, 0.0], radius = 0.01, frequency = 2.0, v = [0.0, nan, 0.0]"),
+        "t.toml:16: grabs[0].circle.v: [0.0, NaN, 0.0] is not a direction",
+    );
     refused(
         &[],
         "[wind]\ndirection = [0.0, 0.0, 0.0]\nstrength = 2.0\n",

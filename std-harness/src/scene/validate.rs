@@ -749,26 +749,56 @@ fn grabs(list: &[GrabSpec]) -> Check {
     for (i, g) in list.iter().enumerate() {
         let f = format!("grabs[{i}]");
         positive(&format!("{f}.force_limit"), g.force_limit, 1000.0, " N")?;
-        if g.path.is_empty() || g.path.len() > 100_000 {
-            return fail(format!("{f}.path"), "allowed 1 to 100000 keys");
-        }
-        let mut previous: Option<f32> = None;
-        for (k, key) in g.path.iter().enumerate() {
-            let kf = format!("{f}.path[{k}]");
-            range(&format!("{kf}.time"), key.time, 0.0, 36_000.0, " s")?;
-            if let Some(p) = previous {
-                if key.time <= p {
-                    return fail(
-                        format!("{kf}.time"),
-                        format!(
-                            "{} s is not after the previous key ({p} s), allowed increasing times",
-                            key.time
-                        ),
-                    );
+        match (&g.path, &g.circle) {
+            (Some(_), Some(_)) => {
+                return fail(
+                    format!("{f}.circle"),
+                    "both path and circle are given, allowed one of them",
+                );
+            }
+            (None, None) => {
+                return fail(format!("{f}.path"), "missing: give path (keys) or circle");
+            }
+            (None, Some(c)) => {
+                point(&format!("{f}.circle.start"), c.start)?;
+                positive(&format!("{f}.circle.radius"), c.radius, 10.0, " m")?;
+                range(
+                    &format!("{f}.circle.frequency"),
+                    c.frequency,
+                    0.0,
+                    100.0,
+                    " Hz",
+                )?;
+                if let Some(u) = c.u {
+                    direction(&format!("{f}.circle.u"), u)?;
+                }
+                if let Some(v) = c.v {
+                    direction(&format!("{f}.circle.v"), v)?;
                 }
             }
-            previous = Some(key.time);
-            point(&format!("{kf}.target"), key.target)?;
+            (Some(path), None) => {
+                if path.is_empty() || path.len() > 100_000 {
+                    return fail(format!("{f}.path"), "allowed 1 to 100000 keys");
+                }
+                let mut previous: Option<f32> = None;
+                for (k, key) in path.iter().enumerate() {
+                    let kf = format!("{f}.path[{k}]");
+                    range(&format!("{kf}.time"), key.time, 0.0, 36_000.0, " s")?;
+                    if let Some(p) = previous {
+                        if key.time <= p {
+                            return fail(
+                                format!("{kf}.time"),
+                                format!(
+                                    "{} s is not after the previous key ({p} s), allowed increasing times",
+                                    key.time
+                                ),
+                            );
+                        }
+                    }
+                    previous = Some(key.time);
+                    point(&format!("{kf}.target"), key.target)?;
+                }
+            }
         }
         if let Some(r) = g.release {
             range(&format!("{f}.release"), r, 0.0, 36_000.0, " s")?;

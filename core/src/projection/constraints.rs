@@ -1,0 +1,413 @@
+//! The constraints of the fast manifold projection (Kmoch 2009 Sec. 8.1): each kind gives its
+//! value `C(x)` and its gradient `∇C(x)`, and [`evaluate`] lays them out so that
+//! `∇C M⁻¹ ∇Cᵀ` stays banded.
+//!
+//! * Inextensibility of segment `j`: `C = e^j·e^j − ê^j·ê^j`, `∇_{x_{j+1}}C = 2e^jᵀ = −∇_{x_j}C`.
+//! * Collision of node `i` with a sphere or capsule: `C = |x_i − c|² − r²`, `∇C = 2(x_i − c)ᵀ`
+//!   (`c` the centre, or the closest point of the capsule's axis; the row uses the secant
+//!   slope `(|x_i − c| + r) n`, equal to it on the surface — see [`contact`]); with a plane:
+//!   `C = (x_i − p)·n`, `∇C = nᵀ`. Only for nodes found inside, re-detected at every iterate.
+//! * Root coupling and grabs have no rows: their nodes are prescribed (`w = 0`). A row on a
+//!   node of infinite mass is a zero row and makes the matrix singular, so prescribed nodes
+//!   never carry a collision row, and a segment between two prescribed nodes has no row.
+//!
+//! Ordered `[contacts of node 0], C_0, [contacts of node 1], C_1, …` the half-bandwidth is
+//! 1 + the most contacts on one node. A collision row touches one node only, so eliminating
+//! it first (its LDLᵀ pivot taken before the segments') fills nothing outside the segments'
+//! tridiagonal band: the segments that share the node see it as a node whose inverse mass is
+//! projected onto the contact's tangent space ([`super::banded::eliminate_contacts`]). So the
+//! segment rows are kept in band order with their envelopes, and each node keeps its
+//! collision rows beside it ([`NodeContacts`]); collisions then cost in proportion to the
+//! contacts and never widen the band.
+
+use crate::collide::{Shape, MAX_COLLIDERS};
+use crate::math::{Math, Real, Vec3};
+use crate::strand::Strand;
+
+/// Most collision rows one node carries per iteration; further contacts of the same node (in
+/// collider order) are left out that iteration and flagged.
+pub const MAX_NODE_CONTACTS: usize = 2;
+
+/// "No row" in [`Rows::segment_row`].
+pub const NO_ROW: u16 = u16::MAX;
+
+/// What a row constrains.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RowKind {
+    /// A placeholder that keeps the layout fixed (fixed-cost mode): `A_rr = 1`, `C = 0`.
+    #[default]
+    Padding,
+    /// Inextensibility of the segment from `nodes[0]` to `nodes[1]`.
+    Segment,
+}
+
+/// One segment row: its value and gradient (two 3-blocks), and the same after the collision
+/// rows of its nodes were eliminated.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Row {
+    /// `C(x_k)`.
+    pub value: Real,
+    /// The right-hand side after eliminating collision rows: `C − Σ_i ∇_{x_i}C · d_i`.
+    pub rhs: Real,
+    /// The two nodes of the segment.
+    pub nodes: [u16; 2],
+    /// `∇_{x_{nodes[0]}} C` and `∇_{x_{nodes[1]}} C`.
+    pub gradient: [Vec3; 2],
+    /// The gradient blocks with each node's contact normals projected out, `(I − P_i)∇C`
+    /// (equal to `gradient` at a node without contact).
+    pub projected: [Vec3; 2],
+    /// What the row constrains.
+    pub kind: RowKind,
+}
+
+impl Row {
+    /// Inextensibility of segment `j` (nodes `j`, `j + 1`): `C = e·e − ê·ê`.
+    #[must_use]
+    pub fn segment(j: usize, x_j: Vec3, x_next: Vec3, rest_length: Real) -> Row {
+        let e = x_next - x_j;
+        let value = e.dot(e) - rest_length * rest_length;
+        let gradient = [e * -2.0, e * 2.0];
+        Row {
+            value,
+            rhs: value,
+            nodes: [j as u16, (j + 1) as u16],
+            gradient,
+            projected: gradient,
+            kind: RowKind::Segment,
+        }
+    }
+}
+
+/// Value and gradient of the collision row of a node found `depth` inside `shape` (negative
+/// when outside: a contact kept from an earlier iterate) with outward `normal`.
+#[must_use]
+pub fn contact(shape: &Shape, normal: Vec3, depth: Real) -> (Real, Vec3) {
+    match *shape {
+        Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => {
+            // d = |x − c| = r − depth; C = d² − r² = −depth (d + r). The gradient 2(x − c) =
+            // 2d·n would send a Newton step to (d² + r²)/(2d) from the centre: five radii out
+            // from d = r/10, infinitely far from d = 0. The secant slope (d + r)·n between
+            // the node and its surface point lands the step on the surface for any depth
+            // (the centre included) and equals 2(x − c) there, at the solution.
+            let distance = radius - depth;
+            (-depth * (distance + radius), normal * (distance + radius))
+        }
+        Shape::Plane { .. } => (-depth, normal),
+    }
+}
+
+/// The collision rows of one node, and what eliminating them leaves for the segments.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeContacts {
+    /// Rows in use (≤ [`MAX_NODE_CONTACTS`]).
+    pub count: u8,
+    /// The collider of each row (its index in the step's list).
+    pub collider: [u8; MAX_NODE_CONTACTS],
+    /// `C` of each row.
+    pub value: [Real; MAX_NODE_CONTACTS],
+    /// `∇_{x_i}C` of each row.
+    pub gradient: [Vec3; MAX_NODE_CONTACTS],
+    /// Rows kept by the elimination (a row whose gradient depends on the first is dropped).
+    pub kept: u8,
+    /// `(GᵀG)⁻¹` of the kept gradients `G`, as `[a₀₀, a₀₁, a₁₁]`.
+    pub inverse_gram: [Real; 3],
+    /// `d = G (GᵀG)⁻¹ C`: minus the smallest move that meets the linearised contacts.
+    pub displacement: Vec3,
+}
+
+impl NodeContacts {
+    fn push(&mut self, collider: u8, value: Real, gradient: Vec3) -> bool {
+        let k = usize::from(self.count);
+        match (
+            self.collider.get_mut(k),
+            self.value.get_mut(k),
+            self.gradient.get_mut(k),
+        ) {
+            (Some(c), Some(v), Some(g)) => {
+                (*c, *v, *g) = (collider, value, gradient);
+                self.count += 1;
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
+/// What the projection needs to know about each node: its inverse mass (zero when
+/// prescribed) and whether it may carry collision rows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Nodes<const N: usize> {
+    /// `w_i = 1/m_i`, or 0 for a prescribed node (root, grab).
+    pub inverse_mass: [Real; N],
+    /// How many nodes the strand has.
+    pub count: usize,
+}
+
+impl<const N: usize> Nodes<N> {
+    /// Whether node `i` is free to move.
+    #[inline(always)]
+    #[must_use]
+    pub fn is_free(&self, i: usize) -> bool {
+        self.inverse_mass.get(i).is_some_and(|&w| w > 0.0)
+    }
+}
+
+/// Which constraints this projection enforces, and how the layout is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Layout {
+    /// Inextensibility rows (effect `inextensibility`).
+    pub inextensibility: bool,
+    /// Collision rows per free node at most: 0 when `collisions` is off or there is no
+    /// collider.
+    pub contact_slots: usize,
+    /// Fixed cost: a row for every segment that may carry one (padding where it cannot) and
+    /// the full band for every row, so the work does not depend on the state.
+    pub fixed_cost: bool,
+}
+
+/// The constraints at one iterate: segment rows in band order, collision rows by node.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rows<const N: usize> {
+    /// The segment rows, in band order (`count` in use).
+    pub rows: [Row; N],
+    /// First column of each row's envelope (`first[r] ≤ r`): the previous row when it shares
+    /// a node with this one.
+    pub first: [u16; N],
+    /// Rows in use.
+    pub count: usize,
+    /// Row index of segment `j`, or [`NO_ROW`].
+    pub segment_row: [u16; N],
+    /// Each node's collision rows.
+    pub contacts: [NodeContacts; N],
+    /// `max_j |C_j| / (ê^j·ê^j)` over segment rows and `depth / |ê^{i−1}|` over nodes inside a
+    /// collider (with or without a row): the relative residual at this iterate.
+    pub residual: Real,
+    /// Whether every row is within the tolerance, or within what f32 positions can resolve
+    /// when that is coarser (see [`resolution_floor`]).
+    pub converged: bool,
+    /// Deepest free node inside a collider at this iterate, m.
+    pub max_depth: Real,
+    /// Whether some node was in more than [`MAX_NODE_CONTACTS`] colliders.
+    pub truncated: bool,
+}
+
+impl<const N: usize> Default for Rows<N> {
+    fn default() -> Self {
+        Rows {
+            rows: [Row::default(); N],
+            first: [0; N],
+            count: 0,
+            segment_row: [NO_ROW; N],
+            contacts: [NodeContacts::default(); N],
+            residual: 0.0,
+            converged: true,
+            max_depth: 0.0,
+            truncated: false,
+        }
+    }
+}
+
+impl<const N: usize> Rows<N> {
+    /// The rows in use.
+    #[must_use]
+    pub fn rows(&self) -> &[Row] {
+        self.rows.get(..self.count).unwrap_or(&[])
+    }
+
+    /// The envelope starts of the rows in use.
+    #[must_use]
+    pub fn first(&self) -> &[u16] {
+        self.first.get(..self.count).unwrap_or(&[])
+    }
+
+    fn push(&mut self, row: Row, first: usize) -> Option<usize> {
+        let r = self.count;
+        *self.rows.get_mut(r)? = row;
+        *self.first.get_mut(r)? = first.min(r) as u16;
+        self.count += 1;
+        Some(r)
+    }
+}
+
+/// What the projection remembers of each node's contacts across its iterations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ContactMemory<const N: usize> {
+    /// Per node, the colliders it got a collision row for (bit `c`) at some iterate.
+    pub touched: [u8; N],
+    /// `Λ` of each node's row for each collider, summed over iterations (< 0: pushing out).
+    pub multipliers: [[Real; MAX_COLLIDERS]; N],
+}
+
+impl<const N: usize> Default for ContactMemory<N> {
+    fn default() -> Self {
+        ContactMemory {
+            touched: [0; N],
+            multipliers: [[0.0; MAX_COLLIDERS]; N],
+        }
+    }
+}
+
+/// Largest absolute coordinate of `p`.
+#[inline(always)]
+fn magnitude(p: Vec3) -> Real {
+    p.x.abs().max(p.y.abs()).max(p.z.abs())
+}
+
+/// What f32 positions can resolve of a constraint's value. Each coordinate is rounded to
+/// `ε|x|`, so `e` is uncertain by `ε·max|x|` per component and `e·e` by `2ε|e|₁·max|x|`
+/// (plus its own rounding, `ε e·e`); a contact depth by `ε` of the coordinates involved.
+/// With 1 cm segments 0.2 m from the origin that is ~5e-6 of `ê·ê`: near or above the
+/// default tolerance 1e-6, which Newton steps then cannot reach (they stall at the rounding).
+/// Rows within this floor count as satisfied; the reported residual stays the true value.
+#[must_use]
+pub fn resolution_floor(is_contact: bool, a: Vec3, b: Vec3, length_scale: Real) -> Real {
+    let eps = Real::EPSILON;
+    let m = magnitude(a).max(magnitude(b));
+    if is_contact {
+        2.0 * eps * (m + length_scale)
+    } else {
+        let e = b - a;
+        2.0 * eps * (e.x.abs() + e.y.abs() + e.z.abs()) * m + eps * e.dot(e)
+    }
+}
+
+/// Outward normal and signed depth (> 0 inside) of `p` against `shape`, inside or not; the
+/// same geometry as [`Shape::penetration`], which only answers inside.
+fn surface<M: Math>(shape: &Shape, p: Vec3) -> (Vec3, Real) {
+    let ball = |centre: Vec3, radius: Real| {
+        let d = p - centre;
+        let distance = M::sqrt(d.dot(d));
+        let normal = if distance > 0.0 {
+            d / distance
+        } else {
+            Vec3::Y
+        };
+        (normal, radius - distance)
+    };
+    match *shape {
+        Shape::Sphere { centre, radius } => ball(centre, radius),
+        Shape::Capsule { a, b, radius } => {
+            let axis = b - a;
+            let length2 = axis.dot(axis);
+            let t = if length2 > 0.0 {
+                ((p - a).dot(axis) / length2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            ball(a + axis * t, radius)
+        }
+        Shape::Plane { point, normal } => (normal, -(p - point).dot(normal)),
+    }
+}
+
+/// Evaluates every constraint at the positions `x` (re-detecting contacts) and lays the rows
+/// out. `colliders` are the step's valid colliders with their index in the step's list.
+///
+/// `memory.touched[i]` has bit `c` set once node `i` got a row for collider `c` in this
+/// projection; such a contact keeps its row even when the node is outside, as long as its
+/// accumulated multiplier `memory.multipliers[i][c]` pushes (`Λ < 0`: the row moves the node
+/// along `−∇C·Λ`, outward). Dropping a row as soon as a step lands its node on the surface
+/// lets the next step, blind to the collider, push the node back through it: the contact set
+/// then flickers and the iteration does not settle. Keeping a row that pulls would glue the
+/// node to the surface, which can be infeasible with the segment lengths (a node held at the
+/// surface out of reach of the root).
+pub fn evaluate<M: Math, const N: usize>(
+    strand: &Strand<N>,
+    nodes: &Nodes<N>,
+    colliders: &[(u8, Shape)],
+    layout: Layout,
+    tolerance: Real,
+    memory: &mut ContactMemory<N>,
+    rows: &mut Rows<N>,
+) {
+    rows.count = 0;
+    rows.residual = 0.0;
+    rows.converged = true;
+    rows.max_depth = 0.0;
+    rows.truncated = false;
+    let x = &strand.state.position;
+    let rest_length = &strand.rest.segment_length;
+    let count = nodes.count.min(N);
+    let mut previous_segment: Option<usize> = None;
+    for i in 0..count {
+        rows.contacts[i].count = 0;
+        rows.segment_row[i] = NO_ROW;
+        if layout.contact_slots > 0 && nodes.is_free(i) {
+            for &(c, ref shape) in colliders {
+                let bit = 1u8 << (c % 8);
+                // Test the bit first: most nodes never touch anything.
+                let sticky = memory.touched[i] & bit != 0
+                    && memory.multipliers[i]
+                        .get(usize::from(c))
+                        .is_some_and(|&lambda| lambda < 0.0);
+                let found = if sticky {
+                    Some(surface::<M>(shape, x[i]))
+                } else {
+                    shape.penetration::<M>(x[i]).map(|c| (c.normal, c.depth))
+                };
+                let Some((normal, depth)) = found else {
+                    continue;
+                };
+                if depth > 0.0 {
+                    // Node i ≥ 2 when free, so the segment before it exists.
+                    let scale = rest_length[i.saturating_sub(1)];
+                    rows.residual = rows.residual.max(depth / scale);
+                    rows.max_depth = rows.max_depth.max(depth);
+                    if rows.converged && depth > tolerance * scale {
+                        let reach = match *shape {
+                            Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
+                            Shape::Plane { point, .. } => magnitude(point),
+                        };
+                        rows.converged = depth <= resolution_floor(true, x[i], x[i], reach);
+                    }
+                }
+                let (value, gradient) = contact(shape, normal, depth);
+                let room = usize::from(rows.contacts[i].count) < layout.contact_slots;
+                if room && rows.contacts[i].push(c, value, gradient) {
+                    memory.touched[i] |= bit;
+                } else {
+                    rows.truncated = true;
+                }
+            }
+        }
+        if i + 1 >= count || !layout.inextensibility {
+            continue;
+        }
+        if nodes.is_free(i) || nodes.is_free(i + 1) {
+            let row = Row::segment(i, x[i], x[i + 1], rest_length[i]);
+            let rest2 = rest_length[i] * rest_length[i];
+            let relative = row.value.abs() / rest2;
+            // `max` would drop a NaN: keep it visible in the residual.
+            if relative.is_nan() || relative > rows.residual {
+                rows.residual = relative;
+            }
+            // The resolution floor only matters while every row so far is met.
+            if rows.converged && row.value.abs() > tolerance * rest2 {
+                let floor = resolution_floor(false, x[i], x[i + 1], 0.0);
+                rows.converged = row.value.abs() <= floor;
+            }
+            let first = previous_segment.unwrap_or(rows.count);
+            previous_segment = rows.push(row, first);
+            if let Some(r) = previous_segment {
+                rows.segment_row[i] = r as u16;
+            }
+        } else {
+            // Both ends prescribed (segment 0, or a grab next to the root or to another grab):
+            // nothing can move, so no row. Fixed cost keeps a padding row in its place
+            // (segment 0 is always prescribed and needs none), so that the row count does
+            // not depend on which grabs hold.
+            if layout.fixed_cost && i >= 1 {
+                rows.push(Row::default(), rows.count);
+            }
+            previous_segment = None;
+        }
+    }
+    if layout.fixed_cost {
+        // The full band for every row: the factorisation's work is the same whatever holds.
+        for (r, first) in rows.first.iter_mut().enumerate().take(rows.count) {
+            *first = r.saturating_sub(1) as u16;
+        }
+    }
+}

@@ -1,0 +1,439 @@
+//! Fast manifold projection (Kmoch 2009 Sec. 8, Goldenthal et al. 2007): after the
+//! unconstrained step, move the nodes to the nearest configuration (in the mass metric) that
+//! satisfies the constraints, then feed the position change back into the velocities.
+//!
+//! Each iteration `k` (at most `RodParams::projection_iterations`):
+//! 1. evaluate `C(x_k)` and `∇C(x_k)`: inextensibility of every segment with a free node,
+//!    and collision rows for the free nodes found inside a collider *at this iterate* (a node
+//!    pushed in by the projection is caught in the same step) — [`constraints`];
+//! 2. stop if `max_j |C_j| / (ê^j·ê^j) ≤ tol` (converge mode only; a row within what f32
+//!    positions can resolve counts as met — see [`constraints::resolution_floor`]);
+//! 3. solve `(∇C M⁻¹ ∇Cᵀ) δλ = C(x_k)` with a banded LDLᵀ — [`banded`]: each node's collision
+//!    rows are eliminated first at their node (no fill), leaving the segments' tridiagonal
+//!    band, so contacts cost O(contacts) and never widen the band;
+//! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`.
+//!
+//! Root coupling and grabs are *prescribed* nodes (`w = 0`, no rows): nodes 0 and 1 were set
+//! by root coupling, grabbed nodes are set to their targets here. Then
+//! `v ← v + Δx/h` with `Δx = x_proj − x_pred` (Kmoch writes `ẋ − Δx/h` with the opposite sign
+//! of `Δx`: the same update).
+//!
+//! Forces, with `Λ = Σ_k δλ_k` (accumulated per iteration with that iteration's gradient, as
+//! collision rows come and go): the constraint force on a node is `−∇CᵀΛ/h²`. A collider feels
+//! the reaction of its collision rows, `+Σ ∇_{x_i}C_cᵀ δλ_c / h²` (the hair pressing on it).
+//! The device holding a grab feels the pull of the adjacent segments on the prescribed node
+//! plus the node's own weight and inertia, `−Σ_adjacent ∇_{x_g}C_jᵀΛ_j/h² − m_g(a_g − g)`;
+//! `m_g(a_g − g)` (with every external acceleration the node got, not only gravity) is
+//! `m_g Δx_g / h²`, the impulse that took the node from its predicted position to the target.
+//! (DESIGN.md prints `+ m_g(a_g − g)`; at rest that would subtract the node's own weight from
+//! the weight held — the two terms must have the same sign, as its 1.7 % remark says.)
+
+pub mod banded;
+pub mod constraints;
+
+use crate::collide::{Shape, MAX_COLLIDERS};
+use crate::context::StepContext;
+use crate::effects::Effect;
+use crate::grab::{grabbed_nodes, Grab, GrabbedNodes, MAX_GRABS};
+use crate::math::{Math, Real, Vec3};
+use crate::params::Mode;
+use crate::report::{Flags, Stage, StepReport};
+use crate::strand::Strand;
+
+use banded::BandRow;
+use constraints::{ContactMemory, Layout, Nodes, Rows, MAX_NODE_CONTACTS};
+
+/// What one projection did, besides what it adds to the report.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Outcome {
+    /// Iterations run (solves), at most the cap.
+    pub iterations: u32,
+    /// Relative residual at the final positions (see [`constraints::Rows::residual`]).
+    pub residual: Real,
+    /// Whether the final positions meet the tolerance (or f32's resolution, if coarser).
+    pub converged: bool,
+    /// Rows dropped at a singular pivot, summed over iterations.
+    pub dropped_rows: u32,
+}
+
+/// Scratch space of one projection: fixed arrays on the stack, nothing on the heap.
+struct Workspace<const N: usize> {
+    /// `x_pred`: the positions after integration and root coupling.
+    predicted: [Vec3; N],
+    nodes: Nodes<N>,
+    /// Which colliders each node touched, and the contact multipliers' sums.
+    contacts: ContactMemory<N>,
+    rows: Rows<N>,
+    band: [BandRow; N],
+    multipliers: [Real; N],
+    /// `Σ_k −∇_{x_g}C_kᵀ δλ_k` per grab slot: the segments' pull on the grabbed node, × h².
+    grab_pull: [Vec3; MAX_GRABS],
+    /// `Σ_k ∇_{x_i}C_kᵀ δλ_k` over each collider's rows: the hair's push on it, × h².
+    collider_push: [Vec3; MAX_COLLIDERS],
+    truncated: bool,
+}
+
+/// Compile-time check that row and node indices fit the `u16`s the rows store.
+struct IndexFits<const N: usize>;
+impl<const N: usize> IndexFits<N> {
+    const OK: () = assert!(
+        N < u16::MAX as usize,
+        "node capacity too large for the projection's u16 row indices"
+    );
+}
+
+/// Projects strand `strand` (index `strand_index` in the whole scene, as in [`Grab::strand`])
+/// onto its constraints after the unconstrained step and updates its velocities; adds its
+/// iterations, residual, stretch, contacts and forces to `report`.
+///
+/// Runs when any of the effects `inextensibility`, `collisions`, `grabs` is on, and builds
+/// only the rows of those that are. Callable on any strand, colliders and grabs (the fuzz
+/// target drives it): it never panics, and degenerate input (coincident nodes, a node at a
+/// sphere's centre, huge stretch) gives finite positions and an honest residual.
+pub fn project_constraints<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    grabs: &[Grab],
+    strand_index: u32,
+    report: &mut StepReport,
+) -> Outcome {
+    #[allow(clippy::let_unit_value)]
+    let () = IndexFits::<N>::OK;
+    let inextensibility = ctx.has(Effect::Inextensibility);
+    let collisions = ctx.has(Effect::Collisions);
+    if !(inextensibility || collisions || ctx.has(Effect::Grabs)) {
+        return Outcome::default();
+    }
+    report.ran(Stage::Projection);
+    if collisions {
+        report.ran(Stage::Collisions);
+    }
+    let n = strand.rest.nodes.min(N);
+    let held = grabbed_nodes(ctx, grabs, strand_index, n);
+    let mut work = Workspace::new(strand, n);
+    prescribe_grabs(strand, grabs, &held, &mut work.nodes);
+    let (shapes, shape_count) = usable_colliders(ctx);
+    let layout = Layout {
+        inextensibility,
+        contact_slots: if collisions {
+            shape_count.min(MAX_NODE_CONTACTS)
+        } else {
+            0
+        },
+        fixed_cost: ctx.params.mode == Mode::FixedCost,
+    };
+    let shapes = shapes.get(..shape_count).unwrap_or(&[]);
+    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    report.ran(Stage::Velocity);
+    update_velocities(strand, &work.predicted, ctx.inv_dt);
+    record::<M, N>(strand, ctx, &outcome, &work, report);
+    record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
+    outcome
+}
+
+impl<const N: usize> Workspace<N> {
+    fn new(strand: &Strand<N>, n: usize) -> Self {
+        let mut inverse_mass = [0.0; N];
+        for (i, (w, &rest)) in inverse_mass
+            .iter_mut()
+            .zip(strand.rest.inverse_mass.iter())
+            .enumerate()
+            .take(n)
+        {
+            // Nodes 0 and 1 follow the head (root coupling): prescribed, infinite mass.
+            *w = if i >= 2 && rest > 0.0 && rest.is_finite() {
+                rest
+            } else {
+                0.0
+            };
+        }
+        Workspace {
+            predicted: strand.state.position,
+            nodes: Nodes {
+                inverse_mass,
+                count: n,
+            },
+            contacts: ContactMemory::default(),
+            rows: Rows::default(),
+            band: [[0.0; banded::MAX_HALF_BANDWIDTH + 1]; N],
+            multipliers: [0.0; N],
+            grab_pull: [Vec3::ZERO; MAX_GRABS],
+            collider_push: [Vec3::ZERO; MAX_COLLIDERS],
+            truncated: false,
+        }
+    }
+}
+
+/// The step's colliders that pass their checks (a bad one can come through `step_strands`),
+/// each with its index in the step's list, packed at the front.
+fn usable_colliders(ctx: &StepContext) -> ([(u8, Shape); MAX_COLLIDERS], usize) {
+    let placeholder = Shape::Plane {
+        point: Vec3::ZERO,
+        normal: Vec3::Y,
+    };
+    let mut shapes = [(0, placeholder); MAX_COLLIDERS];
+    let mut count = 0;
+    for (c, shape) in ctx.colliders().iter().enumerate().take(MAX_COLLIDERS) {
+        if let (true, Some(slot)) = (shape.is_valid(), shapes.get_mut(count)) {
+            // `c < MAX_COLLIDERS = 8`: fits a u8 and the per-node contact bit mask.
+            *slot = (c as u8, *shape);
+            count += 1;
+        }
+    }
+    (shapes, count)
+}
+
+/// Grabbed nodes are prescribed: moved to their targets, infinite mass, no rows.
+fn prescribe_grabs<const N: usize>(
+    strand: &mut Strand<N>,
+    grabs: &[Grab],
+    held: &GrabbedNodes,
+    nodes: &mut Nodes<N>,
+) {
+    for (g, node) in held.iter() {
+        if let (Some(grab), Some(x), Some(w)) = (
+            grabs.get(g),
+            strand.state.position.get_mut(node),
+            nodes.inverse_mass.get_mut(node),
+        ) {
+            *x = grab.target;
+            *w = 0.0;
+        }
+    }
+}
+
+/// The projection's iterations: evaluate, test, solve, move — at most the cap, always the cap
+/// in fixed-cost mode.
+fn iterate<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    shapes: &[(u8, Shape)],
+    layout: Layout,
+    held: &GrabbedNodes,
+    work: &mut Workspace<N>,
+) -> Outcome {
+    let cap = u32::from(ctx.params.rod.projection_iterations);
+    let tolerance = ctx.params.rod.projection_tolerance;
+    let mut outcome = Outcome::default();
+    for k in 0..=cap {
+        constraints::evaluate::<M, N>(
+            strand,
+            &work.nodes,
+            shapes,
+            layout,
+            tolerance,
+            &mut work.contacts,
+            &mut work.rows,
+        );
+        work.truncated |= work.rows.truncated;
+        outcome.residual = work.rows.residual;
+        outcome.converged = work.rows.converged;
+        if k == cap || (outcome.converged && !layout.fixed_cost) {
+            break;
+        }
+        match solve_and_move(strand, held, work) {
+            Some(dropped) => outcome.dropped_rows += dropped,
+            // A non-finite multiplier (overflow on absurd input): keep x_k, stop, report.
+            None => {
+                outcome.dropped_rows += 1;
+                break;
+            }
+        }
+        outcome.iterations += 1;
+    }
+    outcome
+}
+
+/// One projection step: `(∇C M⁻¹ ∇Cᵀ) δλ = C`, `x ← x − M⁻¹ ∇Cᵀ δλ`, and the forces' sums.
+/// Returns the rows dropped at a singular pivot, or `None` (and leaves `x` alone) when the
+/// multipliers are not finite.
+fn solve_and_move<const N: usize>(
+    strand: &mut Strand<N>,
+    held: &GrabbedNodes,
+    work: &mut Workspace<N>,
+) -> Option<u32> {
+    let n = work.nodes.count.min(N);
+    let mut dropped = banded::eliminate_contacts(&mut work.rows, n);
+    let rows = work.rows.rows();
+    let first = work.rows.first();
+    let count = rows.len();
+    let band = work.band.get_mut(..count)?;
+    banded::assemble(rows, first, &work.nodes.inverse_mass, band);
+    dropped += banded::factor(band, first);
+    let multipliers = work.multipliers.get_mut(..count)?;
+    for (lambda, row) in multipliers.iter_mut().zip(rows) {
+        *lambda = row.rhs;
+    }
+    banded::solve(band, first, multipliers);
+    if !multipliers.iter().all(|l| l.is_finite()) {
+        return None;
+    }
+    // Segments: x_i −= w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact).
+    let position = &mut strand.state.position;
+    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
+        for ((&node, &gradient), &projected) in row
+            .nodes
+            .iter()
+            .zip(row.gradient.iter())
+            .zip(row.projected.iter())
+        {
+            let i = usize::from(node);
+            let w = work.nodes.inverse_mass.get(i).copied().unwrap_or(0.0);
+            if w > 0.0 {
+                if let Some(x) = position.get_mut(i) {
+                    *x -= projected * (w * lambda);
+                }
+            } else if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
+                *pull -= gradient * lambda;
+            }
+        }
+    }
+    // Contacts: x_i −= d_i, and the multipliers the eliminated rows would have had.
+    for (i, x) in position.iter_mut().enumerate().take(n) {
+        let contacts = work.rows.contacts[i];
+        if contacts.kept == 0 {
+            continue;
+        }
+        let segment_pull = segment_pull_on_node(&work.rows, multipliers, i);
+        *x -= contacts.displacement;
+        let w = work.nodes.inverse_mass[i];
+        let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
+        let kept = usize::from(contacts.kept);
+        for ((&c, &gradient), &lambda) in contacts
+            .collider
+            .iter()
+            .zip(contacts.gradient.iter())
+            .zip(lambdas.iter())
+            .take(kept)
+        {
+            let c = usize::from(c);
+            if let Some(push) = work.collider_push.get_mut(c) {
+                *push += gradient * lambda;
+            }
+            if let Some(sum) = work.contacts.multipliers[i].get_mut(c) {
+                *sum += lambda;
+            }
+        }
+    }
+    Some(dropped)
+}
+
+/// `Σ_s ∇_{x_i}C_s δλ_s` over the (at most two) segments through node `i`, with the gradients
+/// before the elimination.
+fn segment_pull_on_node<const N: usize>(rows: &Rows<N>, multipliers: &[Real], i: usize) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+        let r = rows
+            .segment_row
+            .get(segment)
+            .map_or(usize::MAX, |&r| usize::from(r));
+        if let (Some(row), Some(&lambda)) = (rows.rows.get(r), multipliers.get(r)) {
+            sum += row.gradient[block] * lambda;
+        }
+    }
+    sum
+}
+
+/// `v ← v + Δx/h`, `Δx = x_proj − x_pred` (Goldenthal 2007; Kmoch Sec. 8.2). Nodes 0 and 1
+/// got their velocity from root coupling and were not moved here.
+fn update_velocities<const N: usize>(strand: &mut Strand<N>, predicted: &[Vec3; N], inv_dt: Real) {
+    let n = strand.rest.nodes.min(N);
+    let state = &mut strand.state;
+    let nodes = state
+        .velocity
+        .iter_mut()
+        .zip(state.position.iter())
+        .zip(predicted.iter());
+    for ((v, &x_proj), &x_pred) in nodes.take(n).skip(2) {
+        let delta_x = x_proj - x_pred;
+        *v += delta_x * inv_dt;
+    }
+}
+
+/// Iterations, residual, flags, stretch, contacts and collider forces into the report.
+fn record<M: Math, const N: usize>(
+    strand: &Strand<N>,
+    ctx: &StepContext,
+    outcome: &Outcome,
+    work: &Workspace<N>,
+    report: &mut StepReport,
+) {
+    report.iterations_max = report.iterations_max.max(outcome.iterations);
+    report.iterations_total += outcome.iterations;
+    // `max` would hide a NaN residual; the guard rolls such a strand back anyway.
+    if outcome.residual.is_nan() || outcome.residual > report.residual {
+        report.residual = outcome.residual;
+    }
+    if !outcome.converged {
+        report.cap_hits += 1;
+        report.flags.insert(Flags::CAP_HIT);
+    }
+    if outcome.dropped_rows > 0 {
+        report.dropped_rows += outcome.dropped_rows;
+        report.flags.insert(Flags::SINGULAR);
+    }
+    if work.truncated {
+        report.flags.insert(Flags::CONTACTS_TRUNCATED);
+    }
+    report.max_penetration = report.max_penetration.max(work.rows.max_depth);
+    let n = strand.rest.nodes.min(N);
+    let x = &strand.state.position;
+    for j in 0..n.saturating_sub(1) {
+        let rest = strand.rest.segment_length[j];
+        let e = x[j + 1] - x[j];
+        let stretch = (M::length(e) - rest).abs() / rest;
+        if work.contacts.touched[j] != 0 || work.contacts.touched[j + 1] != 0 {
+            report.max_contact_stretch = report.max_contact_stretch.max(stretch);
+        } else {
+            report.max_stretch = report.max_stretch.max(stretch);
+        }
+    }
+    report.contacts += work
+        .contacts
+        .touched
+        .iter()
+        .take(n)
+        .filter(|&&t| t != 0)
+        .count() as u32;
+    let inv_h2 = ctx.inv_dt * ctx.inv_dt;
+    for (force, push) in report.collider_forces.iter_mut().zip(work.collider_push) {
+        *force += push * inv_h2;
+    }
+}
+
+/// Each held grab's force on its device, and whether it slipped.
+fn record_grabs<M: Math, const N: usize>(
+    strand: &Strand<N>,
+    ctx: &StepContext,
+    grabs: &[Grab],
+    held: &GrabbedNodes,
+    work: &Workspace<N>,
+    report: &mut StepReport,
+) {
+    let inv_h2 = ctx.inv_dt * ctx.inv_dt;
+    for (g, node) in held.iter() {
+        let (Some(grab), Some(&pull), Some(&mass), Some(&x), Some(&x_pred)) = (
+            grabs.get(g),
+            work.grab_pull.get(g),
+            strand.rest.mass.get(node),
+            strand.state.position.get(node),
+            work.predicted.get(node),
+        ) else {
+            continue;
+        };
+        // −Σ ∇_{x_g}C_jᵀΛ_j/h² − m_g(a_g − g), with m_g(a_g − g) = m_g Δx_g/h².
+        let delta_x = x - x_pred;
+        let felt = (pull - delta_x * mass) * inv_h2;
+        if let Some(force) = report.grab_forces.get_mut(g) {
+            *force += felt;
+        }
+        if M::length(felt) > grab.force_limit {
+            report.grabs_slipped |= 1 << g;
+            report.flags.insert(Flags::GRAB_SLIPPED);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,402 @@
+//! Unit tests of the projection, each against something computed independently of it.
+
+use super::*;
+use crate::collide::Collider;
+use crate::effects::Effects;
+use crate::grab::GrabStatus;
+use crate::head::Pose;
+use crate::math::Libm;
+use crate::params::Params;
+use crate::strand::Material;
+
+const N: usize = 32;
+
+fn params(effects: &[Effect], mode: Mode, iterations: u16, tolerance: Real) -> Params {
+    let mut p = Params {
+        effects: Effects::from_slice(effects),
+        mode,
+        ..Params::DEFAULT
+    };
+    p.rod.projection_iterations = iterations;
+    p.rod.projection_tolerance = tolerance;
+    p
+}
+
+fn context(params: &Params, colliders: &[Collider]) -> StepContext {
+    StepContext::new(params, Pose::IDENTITY, Pose::IDENTITY, colliders)
+}
+
+/// A straight strand of `nodes` nodes 1 cm apart along `direction` from `root`.
+fn line(nodes: usize, root: Vec3, direction: Vec3) -> Strand<N> {
+    let points: [Vec3; N] = core::array::from_fn(|i| root + direction * (0.01 * i as Real));
+    Strand::from_polyline(&points[..nodes], &Material::HUMAN_HAIR).unwrap()
+}
+
+/// `max_j |e·e − ê·ê| / ê·ê`, computed here in f64 from the positions.
+fn relative_residual(strand: &Strand<N>) -> f64 {
+    let x = strand.positions();
+    (0..x.len() - 1)
+        .map(|j| {
+            let e = [
+                x[j + 1].x - x[j].x,
+                x[j + 1].y - x[j].y,
+                x[j + 1].z - x[j].z,
+            ]
+            .map(f64::from);
+            let l = f64::from(strand.rest.segment_length[j]);
+            (e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - l * l).abs() / (l * l)
+        })
+        .fold(0.0, f64::max)
+}
+
+/// What f32 positions can resolve of `|e·e − ê·ê| / ê·ê` for 1 cm segments within 0.3 m of
+/// the origin: a few ulps of the coordinates over the segment length.
+const F32_FLOOR: f64 = 1.0e-5;
+
+/// Perturbs the free nodes deterministically (a violent unconstrained step).
+fn shake_nodes(strand: &mut Strand<N>, amplitude: Real) {
+    for i in 2..strand.nodes() {
+        let k = i as Real;
+        strand.state.position[i] +=
+            Vec3::new((k * 1.7).sin(), (k * 2.3).cos(), (k * 0.9).sin()) * amplitude;
+    }
+}
+
+#[test]
+fn converge_mode_stops_at_the_tolerance() {
+    let mut used = [0u32; 2];
+    for (slot, tolerance) in [1.0e-2, 1.0e-6].into_iter().enumerate() {
+        let p = params(&[Effect::Inextensibility], Mode::Converge, 50, tolerance);
+        let ctx = context(&p, &[]);
+        let mut strand = line(20, Vec3::ZERO, Vec3::X);
+        shake_nodes(&mut strand, 0.004);
+        let before = relative_residual(&strand);
+        let mut report = StepReport::default();
+        let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+        let after = relative_residual(&strand);
+        assert!(
+            before > 0.1,
+            "the test needs a real violation, got {before}"
+        );
+        assert!(outcome.converged && (outcome.residual <= tolerance || tolerance < 1e-5));
+        assert!(
+            after <= f64::from(tolerance) + F32_FLOOR,
+            "residual {after} above {tolerance}"
+        );
+        assert!((after - f64::from(outcome.residual)).abs() <= F32_FLOOR);
+        assert_eq!(report.cap_hits, 0);
+        assert!(!report.flags.contains(Flags::CAP_HIT));
+        assert!(outcome.iterations < 50);
+        used[slot] = outcome.iterations;
+    }
+    // A looser tolerance stops earlier: converge mode does not run the cap.
+    assert!(used[0] < used[1], "iterations {used:?}");
+}
+
+#[test]
+fn a_low_cap_is_reported_as_a_cap_hit_with_the_true_residual() {
+    let p = params(&[Effect::Inextensibility], Mode::Converge, 1, 1.0e-6);
+    let ctx = context(&p, &[]);
+    let mut strand = line(20, Vec3::ZERO, Vec3::X);
+    shake_nodes(&mut strand, 0.004);
+    let mut report = StepReport::default();
+    let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+    assert_eq!(outcome.iterations, 1);
+    assert!(report.flags.contains(Flags::CAP_HIT) && report.cap_hits == 1);
+    let truth = relative_residual(&strand);
+    assert!(truth > 1e-6);
+    assert!((f64::from(report.residual) - truth).abs() <= 1e-3 * truth + F32_FLOOR);
+}
+
+#[test]
+fn velocities_take_the_position_change_over_h() {
+    let p = params(&[Effect::Inextensibility], Mode::Converge, 20, 1.0e-6);
+    let ctx = context(&p, &[]);
+    let mut strand = line(10, Vec3::ZERO, Vec3::X);
+    shake_nodes(&mut strand, 0.002);
+    let predicted = strand.state.clone();
+    let mut report = StepReport::default();
+    project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+    for i in 0..10 {
+        let delta_x = strand.state.position[i] - predicted.position[i];
+        let expected = predicted.velocity[i] + delta_x * ctx.inv_dt;
+        assert!((strand.state.velocity[i] - expected).length() <= 1e-4 * (1.0 + expected.length()));
+        if i < 2 {
+            assert_eq!(delta_x, Vec3::ZERO, "root nodes are prescribed");
+        }
+    }
+    assert_eq!(report.runs(Stage::Velocity), 1);
+}
+
+#[test]
+fn effects_that_are_off_compute_nothing() {
+    let p = params(&[Effect::Gravity], Mode::Converge, 8, 1.0e-6);
+    let ctx = context(&p, &[]);
+    let mut strand = line(10, Vec3::ZERO, Vec3::X);
+    shake_nodes(&mut strand, 0.002);
+    let before = strand.clone();
+    let mut report = StepReport::default();
+    project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+    assert_eq!(strand, before);
+    assert_eq!(report, StepReport::default());
+    // Collisions alone: no segment rows, so the stretch stays, but nodes leave the collider.
+    let floor = Collider {
+        shape: Shape::Plane {
+            point: Vec3::new(0.0, 0.001, 0.0),
+            normal: Vec3::Y,
+        },
+        attached_to_head: false,
+    };
+    let p = params(&[Effect::Collisions], Mode::Converge, 8, 1.0e-6);
+    let ctx = context(&p, &[floor]);
+    let mut report = StepReport::default();
+    project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+    assert_eq!(report.runs(Stage::Collisions), 1);
+    assert!(
+        relative_residual(&strand) > 0.1,
+        "no inextensibility row was built"
+    );
+    assert!(strand.positions()[2..].iter().all(|x| x.y >= 0.001 - 1e-7));
+}
+
+#[test]
+fn nodes_end_outside_every_shape_with_segments_at_length() {
+    let shapes = [
+        Shape::Sphere {
+            centre: Vec3::new(0.05, -0.03, 0.0),
+            radius: 0.04,
+        },
+        Shape::Capsule {
+            a: Vec3::new(0.0, 0.0, -0.1),
+            b: Vec3::new(0.2, 0.0, 0.1),
+            radius: 0.015,
+        },
+        Shape::Plane {
+            point: Vec3::new(0.0, 0.004, 0.0),
+            normal: Vec3::Y,
+        },
+    ];
+    for shape in shapes {
+        let collider = Collider {
+            shape,
+            attached_to_head: false,
+        };
+        let p = params(
+            &[Effect::Inextensibility, Effect::Collisions],
+            Mode::Converge,
+            30,
+            1.0e-6,
+        );
+        let ctx = context(&p, &[collider]);
+        let mut strand = line(20, Vec3::new(0.0, 0.02, 0.0), Vec3::X);
+        // Sink the free nodes: some end up inside the shape.
+        for i in 2..20 {
+            strand.state.position[i].y -= 0.02;
+        }
+        let mut report = StepReport::default();
+        let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+        assert!(report.contacts > 0, "{shape:?}: the test needs contacts");
+        for (i, x) in strand.positions().iter().enumerate().skip(2) {
+            let depth = shape.penetration::<Libm>(*x).map_or(0.0, |c| c.depth);
+            assert!(depth <= 1e-7, "{shape:?}: node {i} {depth} m deep");
+        }
+        let truth = relative_residual(&strand);
+        assert!(truth <= 1e-6 + F32_FLOOR, "{shape:?}: {truth}");
+        assert!(outcome.converged && !report.flags.contains(Flags::CAP_HIT));
+        assert!(f64::from(outcome.residual) <= 1e-6 + F32_FLOOR);
+        assert!(report.max_penetration <= 1e-7);
+    }
+}
+
+#[test]
+fn a_strand_lying_on_a_floor_presses_on_it_with_its_weight() {
+    // Horizontal strand on the plane y = 0, at rest: every step gravity sinks the free nodes
+    // by h²g and the contact rows lift them back. The floor must feel the free nodes' weight.
+    let floor = Collider {
+        shape: Shape::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        },
+        attached_to_head: false,
+    };
+    let p = params(
+        &[Effect::Gravity, Effect::Inextensibility, Effect::Collisions],
+        Mode::Converge,
+        8,
+        1.0e-6,
+    );
+    let mut world = crate::world::World::<1, N, Libm>::with_params(p).unwrap();
+    world.add_collider(floor).unwrap();
+    world.add_strand(line(30, Vec3::ZERO, Vec3::X)).unwrap();
+    let input = crate::world::StepInput {
+        head: Pose::IDENTITY,
+        accelerations: None,
+    };
+    let mut report = StepReport::default();
+    for _ in 0..50 {
+        report = world.step(&input);
+    }
+    let strand = &world.strands()[0];
+    let free_weight: Real = strand.rest.mass[2..30].iter().sum::<Real>() * 9.81;
+    let force = report.collider_forces[0];
+    assert!(
+        (force.y + free_weight).abs() <= 0.01 * free_weight,
+        "{force} vs {free_weight}"
+    );
+    assert!(force.x.abs() + force.z.abs() <= 1e-3 * free_weight);
+    assert_eq!(report.contacts, 28);
+    assert!(report.max_contact_stretch <= 1e-5 && report.max_penetration <= 1e-7);
+}
+
+#[test]
+fn garbage_gives_finite_positions_and_an_honest_residual() {
+    let sphere = Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::new(0.05, 0.0, 0.0),
+            radius: 0.02,
+        },
+        attached_to_head: false,
+    };
+    let effects = [Effect::Inextensibility, Effect::Collisions, Effect::Grabs];
+    for mode in [Mode::Converge, Mode::FixedCost] {
+        for case in 0..4 {
+            let p = params(&effects, mode, 8, 1.0e-6);
+            let ctx = context(&p, &[sphere]);
+            let mut strand = line(12, Vec3::ZERO, Vec3::X);
+            match case {
+                // Every free node at one point.
+                0 => (2..12).for_each(|i| strand.state.position[i] = Vec3::new(0.3, 0.3, 0.3)),
+                // Huge stretch: a node 100 m away.
+                1 => strand.state.position[7] = Vec3::new(100.0, -50.0, 20.0),
+                // A node exactly at the sphere's centre, its neighbours at one point.
+                2 => {
+                    strand.state.position[5] = Vec3::new(0.05, 0.0, 0.0);
+                    strand.state.position[6] = strand.state.position[7];
+                }
+                // All of it, with a grab on a node next to the root and one on a far node.
+                _ => {
+                    (2..6).for_each(|i| strand.state.position[i] = Vec3::new(0.05, 0.0, 0.0));
+                    strand.state.position[9] = Vec3::new(1.0e4, 0.0, 0.0);
+                }
+            }
+            let grabs = [
+                Grab::new(0, 2, Vec3::new(0.02, 0.0, 0.0), 1.0),
+                Grab::new(0, 11, Vec3::new(-3.0, 0.0, 0.0), 1.0),
+            ];
+            let grabs = if case == 3 { &grabs[..] } else { &[] };
+            let mut report = StepReport::default();
+            let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, grabs, 0, &mut report);
+            assert!(
+                strand.is_finite(),
+                "{mode:?} case {case}: {:?}",
+                strand.positions()
+            );
+            assert!(outcome.residual.is_finite() && report.residual.is_finite());
+            // Honest: the reported residual is the residual of the final positions (with any
+            // node still inside the sphere), or larger when a contact remains.
+            let truth = relative_residual(&strand);
+            assert!(
+                f64::from(outcome.residual) >= truth * (1.0 - 1e-3),
+                "case {case}"
+            );
+            if outcome.residual > 1.0e-3 {
+                assert!(!outcome.converged);
+                assert!(
+                    report.flags.contains(Flags::CAP_HIT),
+                    "{mode:?} case {case}"
+                );
+            }
+            if mode == Mode::FixedCost {
+                assert_eq!(outcome.iterations, 8);
+            }
+        }
+    }
+}
+
+#[test]
+fn two_contacts_with_the_same_normal_are_dropped_not_divided_by() {
+    // Two identical planes: two collision rows with the same gradient on each node inside.
+    let plane = Collider {
+        shape: Shape::Plane {
+            point: Vec3::new(0.0, 0.001, 0.0),
+            normal: Vec3::Y,
+        },
+        attached_to_head: false,
+    };
+    let p = params(
+        &[Effect::Inextensibility, Effect::Collisions],
+        Mode::Converge,
+        8,
+        1.0e-6,
+    );
+    let ctx = context(&p, &[plane, plane]);
+    let mut strand = line(10, Vec3::ZERO, Vec3::X);
+    let mut report = StepReport::default();
+    let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+    assert!(strand.is_finite());
+    assert!(outcome.dropped_rows > 0 && report.flags.contains(Flags::SINGULAR));
+    assert!(strand.positions()[2..].iter().all(|x| x.y >= 0.001 - 1e-7));
+    assert!(relative_residual(&strand) <= 1e-6 + F32_FLOOR);
+}
+
+#[test]
+fn fixed_cost_runs_the_cap_whatever_the_state() {
+    let sphere = Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::new(0.05, -0.005, 0.0),
+            radius: 0.025,
+        },
+        attached_to_head: false,
+    };
+    let effects = [Effect::Inextensibility, Effect::Collisions];
+    let p = params(&effects, Mode::FixedCost, 6, 1.0e-6);
+    let ctx = context(&p, &[sphere]);
+    let mut calm = line(20, Vec3::new(0.0, 0.03, 0.0), Vec3::X);
+    let mut violent = calm.clone();
+    shake_nodes(&mut violent, 0.02);
+    let (mut a, mut b) = (StepReport::default(), StepReport::default());
+    let calm_outcome = project_constraints::<Libm, N>(&mut calm, &ctx, &[], 0, &mut a);
+    let violent_outcome = project_constraints::<Libm, N>(&mut violent, &ctx, &[], 0, &mut b);
+    assert_eq!(calm_outcome.iterations, 6);
+    assert_eq!(violent_outcome.iterations, 6);
+    assert_eq!(a.iterations_total, b.iterations_total);
+    assert!(
+        b.contacts > 0 && a.contacts == 0,
+        "contacts {} and {}",
+        a.contacts,
+        b.contacts
+    );
+}
+
+#[test]
+fn grabbed_nodes_follow_the_rules() {
+    let p = params(&[Effect::Grabs], Mode::Converge, 8, 1.0e-6);
+    let ctx = context(&p, &[]);
+    let target = Vec3::ONE;
+    let mut released = Grab::new(0, 4, target, 1.0);
+    released.status = GrabStatus::Released;
+    let grabs = [
+        Grab::new(0, 1, target, 1.0),     // a root node: refused
+        Grab::new(1, 3, target, 1.0),     // another strand
+        Grab::new(0, 5, target, 1.0),     // held
+        Grab::new(0, 5, Vec3::ZERO, 1.0), // same node: the first one holds it
+        released,                         // past MAX_GRABS anyway
+    ];
+    let held = grabbed_nodes(&ctx, &grabs, 0, 10);
+    assert_eq!(held.len(), 1);
+    assert_eq!(held.iter().next(), Some((2, 5)));
+    assert!(held.contains(5) && !held.contains(3));
+    assert_eq!(grabbed_nodes(&ctx, &grabs, 1, 10).grab_of(3), Some(1));
+    assert!(
+        grabbed_nodes(&ctx, &grabs, 0, 5).is_empty(),
+        "node 5 of a 5-node strand"
+    );
+    let off = context(
+        &params(&[Effect::Inextensibility], Mode::Converge, 8, 1e-6),
+        &[],
+    );
+    assert!(
+        grabbed_nodes(&off, &grabs, 0, 10).is_empty(),
+        "grabs effect off"
+    );
+}
