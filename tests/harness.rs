@@ -405,3 +405,54 @@ fn run_options_are_range_checked() {
         "--steps: 0 is out of range, allowed 1 or more"
     );
 }
+
+/// The scene's `[rod] twist` reaches the core: Newton and hair-optimised twist differ.
+#[test]
+fn the_twist_method_is_the_scenes() {
+    // Curved strands on a shaking head: the twist has work to do.
+    let mut scene = hairsim::builtin::firmware_scene();
+    let go = |scene: &Scene| {
+        let loaded = hairsim::run::Loaded {
+            source: "twist".into(),
+            scene: scene.clone(),
+            prepared: scene.prepare().unwrap(),
+        };
+        run(
+            &loaded,
+            &RunOptions {
+                steps: Some(100),
+                ..RunOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let optimised = go(&scene);
+    scene.rod = Some(hairsim::scene::RodSpec {
+        twist: Some("newton".into()),
+        ..Default::default()
+    });
+    assert_eq!(
+        scene.prepare().unwrap().params.rod.twist,
+        hairsim_core::params::TwistMethod::Newton
+    );
+    let newton = go(&scene);
+    assert!(optimised.finite && newton.finite);
+    assert_ne!(optimised.state_hash, newton.state_hash);
+}
+
+/// The haptic scene reports the force its grab transmits.
+#[test]
+fn the_haptic_scene_reports_its_grab_force() {
+    let summary = hairsim::run::run_builtin(
+        "haptic",
+        &RunOptions {
+            steps: Some(300),
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let forces = summary.grab_forces.expect("grab forces");
+    assert_eq!(forces.len(), 1);
+    assert!(forces[0].iter().any(|f| *f != 0.0), "{forces:?}");
+    assert_eq!(summary.grab_status.unwrap(), vec!["held".to_string()]);
+}

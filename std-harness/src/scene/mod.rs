@@ -138,6 +138,12 @@ pub struct RodSpec {
     /// Projection tolerance (relative).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub projection_tolerance: Option<f32>,
+    /// Iteration cap of the Newton twist.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub newton_iterations: Option<u32>,
+    /// Newton twist tolerance on the largest angle update, rad.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub newton_tolerance: Option<f32>,
 }
 
 /// `[dftl]`.

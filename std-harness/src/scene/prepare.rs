@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use hairsim_core::params::{DftlParams, RodParams, WindParams};
+use hairsim_core::params::{DftlParams, RodParams, TwistMethod, WindParams};
 use hairsim_core::{
     Collider, Effect, Effects, Material, Mode, ParamError, Params, Real, Shake, Shape, Solver,
     Strand, Vec3,
@@ -182,6 +182,17 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
             projection_tolerance: rod
                 .projection_tolerance
                 .unwrap_or(defaults.rod.projection_tolerance),
+            twist: match rod.twist.as_deref() {
+                Some("newton") => TwistMethod::Newton,
+                Some(_) => TwistMethod::HairOptimised,
+                None => defaults.rod.twist,
+            },
+            newton_iterations: rod
+                .newton_iterations
+                .map_or(defaults.rod.newton_iterations, |n| n as u16),
+            newton_tolerance: rod
+                .newton_tolerance
+                .unwrap_or(defaults.rod.newton_tolerance),
             ..defaults.rod
         },
         dftl: DftlParams {

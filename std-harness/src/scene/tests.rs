@@ -239,8 +239,13 @@ fn material_rod_and_dftl_errors() {
     );
     refused(
         &[],
-        "[rod]\ntwist = \"newton\"\n",
-        "t.toml:13: rod.twist: \"newton\" twist is not built yet, allowed \"hair-optimised\"",
+        "[rod]\nnewton_iterations = 0\n",
+        "t.toml:13: rod.newton_iterations: 0 is out of range, allowed 1 to 100",
+    );
+    refused(
+        &[],
+        "[rod]\nnewton_tolerance = 0.0\n",
+        "t.toml:13: rod.newton_tolerance: 0 is out of range, allowed > 0 and <= 1 rad",
     );
     refused(
         &[],

@@ -316,18 +316,18 @@ fn rod(scene: &Scene) -> Check {
     let Some(rod) = &scene.rod else { return Ok(()) };
     if let Some(twist) = &rod.twist {
         one_of("rod.twist", twist, &["hair-optimised", "newton"])?;
-        if twist == "newton" {
-            return fail(
-                "rod.twist",
-                "\"newton\" twist is not built yet, allowed \"hair-optimised\"",
-            );
-        }
     }
     if let Some(n) = rod.projection_iterations {
         count("rod.projection_iterations", u64::from(n), 1, 1000)?;
     }
     if let Some(t) = rod.projection_tolerance {
         positive("rod.projection_tolerance", t, 1.0, "")?;
+    }
+    if let Some(n) = rod.newton_iterations {
+        count("rod.newton_iterations", u64::from(n), 1, 100)?;
+    }
+    if let Some(t) = rod.newton_tolerance {
+        positive("rod.newton_tolerance", t, 1.0, " rad")?;
     }
     Ok(())
 }
