@@ -88,6 +88,7 @@ fn every_builtin_runs_100_steps_and_stays_finite() {
         )
         .unwrap();
         assert!(summary.finite, "{}", b.name);
+        assert!(summary.max_stretch < 1e-2, "{}: stretch {}", b.name, summary.max_stretch);
         assert_eq!(summary.steps, 100);
         assert_eq!(summary.rolled_back, 0, "{}", b.name);
     }

@@ -372,7 +372,7 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
                 format!(
                     "strand {} does not exist, allowed 0 to {} (hair strands first, then [[strands]])",
                     g.strand,
-                    strands.len() - 1
+                    strands.len().saturating_sub(1)
                 ),
             ));
         };
