@@ -88,7 +88,12 @@ fn every_builtin_runs_100_steps_and_stays_finite() {
         )
         .unwrap();
         assert!(summary.finite, "{}", b.name);
-        assert!(summary.max_stretch < 1e-2, "{}: stretch {}", b.name, summary.max_stretch);
+        assert!(
+            summary.max_stretch < 1e-2,
+            "{}: stretch {}",
+            b.name,
+            summary.max_stretch
+        );
         assert_eq!(summary.steps, 100);
         assert_eq!(summary.rolled_back, 0, "{}", b.name);
     }
@@ -223,13 +228,30 @@ fn hair_hair_runs_when_called_for_and_is_thread_independent() {
 }
 
 #[test]
-fn every_shipped_scene_passes_check() {
+fn every_shipped_scene_passes_check_and_runs_200_steps() {
     let mut count = 0;
     for entry in std::fs::read_dir(workspace().join("scenes")).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             hairsim::cmd::check::check(path.to_str().unwrap(), &HairFileOptions::default())
                 .unwrap_or_else(|e| panic!("{e:#}"));
+            let loaded = load(path.to_str().unwrap(), &HairFileOptions::default()).unwrap();
+            let summary = run(
+                &loaded,
+                &RunOptions {
+                    steps: Some(200),
+                    threads: 2,
+                    ..RunOptions::default()
+                },
+            )
+            .unwrap();
+            assert!(summary.finite, "{}", path.display());
+            assert!(
+                summary.max_stretch < 1e-2,
+                "{}: stretch {}",
+                path.display(),
+                summary.max_stretch
+            );
             count += 1;
         }
     }
