@@ -105,3 +105,39 @@ fn newer_formats_other_builds_and_strangers_are_refused() {
     );
     std::fs::remove_file(path).ok();
 }
+
+/// A scene reading a hair file relative to its own folder replays from anywhere.
+#[test]
+fn a_hair_file_scene_replays_from_another_folder() {
+    let dir = std::env::temp_dir().join(format!("hairsim-replay-{}-hair", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("elsewhere")).unwrap();
+    let strands: Vec<Vec<hairsim_core::Vec3>> = (0..5)
+        .map(|k| {
+            (0..12)
+                .map(|i| hairsim_core::Vec3::new(0.02 * k as f32, -0.01 * i as f32, 0.0))
+                .collect()
+        })
+        .collect();
+    hairsim::export::save(&dir.join("wisps.hair"), &strands).unwrap();
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "format = 1\nname = \"wisps\"\nsolver = \"rod\"\ndt = 0.001\nsteps = 60\neffects = [\"gravity\", \"bending\", \"inextensibility\"]\n[head.motion.shake]\naxis = [0.0, 1.0, 0.0]\namplitude = 0.3\nfrequency = 2.0\n[hair.file]\npath = \"wisps.hair\"\n",
+    )
+    .unwrap();
+    let recording = dir.join("elsewhere").join("wisps.rec");
+    let loaded = load(scene.to_str().unwrap(), &HairFileOptions::default()).unwrap();
+    let recorded = run(
+        &loaded,
+        &RunOptions {
+            record: Some(recording.clone()),
+            ..RunOptions::default()
+        },
+    )
+    .unwrap();
+    let replayed = replay(&recording, 1).unwrap();
+    assert_eq!(replayed.state_hash, recorded.state_hash);
+    assert_eq!(replayed.strands, 5);
+    std::fs::remove_dir_all(dir).ok();
+}

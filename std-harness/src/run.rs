@@ -60,6 +60,7 @@ pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
         };
         let scene = crate::hairscene::scene_for_hair_file(path, hair).map_err(scene_error)?;
         let prepared = scene.prepare().map_err(scene_error)?;
+        let scene = with_absolute_hair_file(scene, Path::new("."));
         return Ok(Loaded {
             source: spec.to_string(),
             scene,
@@ -76,9 +77,21 @@ pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
     let (scene, prepared) = Scene::load(path)?;
     Ok(Loaded {
         source: spec.to_string(),
-        scene,
+        scene: with_absolute_hair_file(scene, path.parent().unwrap_or(Path::new("."))),
         prepared,
     })
+}
+
+/// The scene with its hair file's path made absolute (from `base`), so that a recording of it
+/// replays from any folder.
+fn with_absolute_hair_file(mut scene: Scene, base: &Path) -> Scene {
+    if let Some(crate::scene::HairSpec::File(file)) = &mut scene.hair {
+        let joined = base.join(&file.path);
+        if let Ok(absolute) = std::path::absolute(&joined) {
+            file.path = absolute.display().to_string();
+        }
+    }
+    scene
 }
 
 /// Options of `hairsim run` that do not depend on the scene.
