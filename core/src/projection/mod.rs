@@ -124,12 +124,52 @@ pub fn project_constraints<M: Math, const N: usize>(
         fixed_cost: ctx.params.mode == Mode::FixedCost,
     };
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
-    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    let mut outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    keep_finite(strand, &work, n, ctx.inv_dt, &mut outcome);
     report.ran(Stage::Velocity);
     update_velocities(strand, &work.predicted, ctx.inv_dt);
     record::<M, N>(strand, ctx, &outcome, &work, report);
     record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
     outcome
+}
+
+/// Finite in, finite out: if a degenerate configuration (found by the fuzz target: a capsule,
+/// several planes and a grab on one node) overflowed an iterate, the strand keeps the
+/// positions it came in with — finite, unprojected — and the outcome says the constraints are
+/// not met, with the inextensibility residual of those positions and one more dropped row.
+/// "Overflowed" includes a finite move so large that the velocity update `Δx/h` would not be.
+fn keep_finite<const N: usize>(
+    strand: &mut Strand<N>,
+    work: &Workspace<N>,
+    n: usize,
+    inv_dt: Real,
+    outcome: &mut Outcome,
+) {
+    let position = &mut strand.state.position;
+    let finite = position
+        .iter()
+        .zip(work.predicted.iter())
+        .take(n)
+        .all(|(x, p)| crate::math::is_finite((*x - *p) * inv_dt));
+    if finite {
+        return;
+    }
+    *position = work.predicted;
+    outcome.converged = false;
+    outcome.dropped_rows += 1;
+    let mut residual: Real = 0.0;
+    for j in 1..n.saturating_sub(1) {
+        let e = position[j + 1] - position[j];
+        let rest = strand.rest.segment_length[j];
+        let relative = (e.dot(e) - rest * rest).abs() / (rest * rest);
+        if relative.is_nan() || relative > residual {
+            residual = relative;
+        }
+    }
+    outcome.residual = outcome.residual.max(residual);
+    if !outcome.residual.is_finite() {
+        outcome.residual = Real::MAX;
+    }
 }
 
 impl<const N: usize> Workspace<N> {
