@@ -333,7 +333,9 @@ pub fn elastic_energy<P: Precision, const N: usize>(
 ) -> P::R {
     let cos_sin = material_angles::<P, N>(theta);
     let mut energy = P::R::ZERO;
-    for i in 1..=frames.interior() {
+    // A shorter `theta` truncates the strand rather than reading past it.
+    let n = frames.interior().min(theta.len().saturating_sub(1));
+    for i in 1..=n {
         for k in 0..2 {
             energy += node_bending_energy(frames, rest, terms, i, k, cos_sin[i - 1 + k]);
         }
@@ -424,9 +426,13 @@ pub fn twist_derivative<P: Precision, const N: usize>(
     terms: ElasticTerms,
     j: usize,
 ) -> P::R {
-    let (s, c) = P::sin_cos(theta[j]);
+    let Some(&angle) = theta.get(j) else {
+        return P::R::ZERO;
+    };
+    let (s, c) = P::sin_cos(angle);
+    let n = frames.interior().min(theta.len().saturating_sub(1));
     bending_twist_derivative(frames, rest, terms, j, [c, s])
-        + twist_twist_derivative(rest, terms, theta, j, frames.interior())
+        + twist_twist_derivative(rest, terms, theta, j, n)
 }
 
 /// The elastic forces (Kmoch Sec. 7.2, BWR08 Sec. 7):
