@@ -363,7 +363,9 @@ pub fn evaluate<M: Math, const N: usize>(
                             Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
                             Shape::Plane { point, .. } => magnitude(point),
                         };
-                        rows.converged = depth <= resolution_floor(true, x[i], x[i], reach);
+                        // Past 1 % of the segment f32 resolves nothing: not converged.
+                        let floor = resolution_floor(true, x[i], x[i], reach).min(0.01 * scale);
+                        rows.converged = depth <= floor;
                     }
                 }
                 let (value, gradient) = contact(shape, normal, depth);
@@ -388,7 +390,7 @@ pub fn evaluate<M: Math, const N: usize>(
             }
             // The resolution floor only matters while every row so far is met.
             if rows.converged && row.value.abs() > tolerance * rest2 {
-                let floor = resolution_floor(false, x[i], x[i + 1], 0.0);
+                let floor = resolution_floor(false, x[i], x[i + 1], 0.0).min(0.01 * rest2);
                 rows.converged = row.value.abs() <= floor;
             }
             let first = previous_segment.unwrap_or(rows.count);
