@@ -11,7 +11,8 @@
 //! 3. solve `(∇C M⁻¹ ∇Cᵀ) δλ = C(x_k)` with a banded LDLᵀ — [`banded`]: each node's collision
 //!    rows are eliminated first at their node (no fill), leaving the segments' tridiagonal
 //!    band, so contacts cost O(contacts) and never widen the band;
-//! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`.
+//! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`, scaled down whole if it would move a node further
+//!    than the strand is long (a trust region that only garbage input ever meets).
 //!
 //! Root coupling and grabs are *prescribed* nodes (`w = 0`, no rows): nodes 0 and 1 were set
 //! by root coupling, grabbed nodes are set to their targets here. Then
@@ -92,8 +93,8 @@ impl<const N: usize> IndexFits<N> {
 /// iterations, residual, stretch, contacts and forces to `report`.
 ///
 /// Runs when any of the effects `inextensibility`, `collisions`, `grabs` is on, and builds
-/// only the rows of those that are. Callable on any strand, colliders and grabs (the fuzz
-/// target drives it): it never panics, and degenerate input (coincident nodes, a node at a
+/// only the rows of those that are. Callable on any strand, colliders and grabs (so that a
+/// fuzz target can drive it with a `StepContext::new` of its own): it never panics, and degenerate input (coincident nodes, a node at a
 /// sphere's centre, huge stretch) gives finite positions and an honest residual.
 pub fn project_constraints<M: Math, const N: usize>(
     strand: &mut Strand<N>,
