@@ -10,7 +10,7 @@ fn firmware_step(c: &mut Criterion) {
     let mut k = 0u32;
     c.bench_function("firmware scene step", |b| {
         b.iter(|| {
-            let report = world.step(&firmware::input::<Libm>(k));
+            let report = firmware::step(&mut world, k);
             k = k.wrapping_add(1);
             report
         })

@@ -5,6 +5,8 @@
 //! one `hairsim run firmware` computes on the host.
 
 use hairsim::run::{run_builtin, RunOptions};
+use hairsim_core::scenes::firmware_dftl;
+use hairsim_core::{Libm, World};
 
 fn firmware_hash(log: &str, scene: &str) -> Option<String> {
     let line = log
@@ -27,6 +29,18 @@ fn firmware_under_qemu_prints_the_host_hash() {
     let host = run_builtin("firmware", &RunOptions::default()).unwrap();
     assert_eq!(host.state_hash, target, "host and Cortex-M4F hashes differ");
     assert!(log.contains("finite true"));
+
+    // The DFTL scene, stepped on the host exactly as the firmware steps it.
+    let target = firmware_hash(&log, "firmware-dftl")
+        .unwrap_or_else(|| panic!("no `scene firmware-dftl … state_hash` line in:\n{log}"));
+    let mut world: Box<World<{ firmware_dftl::STRANDS }, { firmware_dftl::NODES }, Libm>> =
+        Box::default();
+    let host = firmware_dftl::run(&mut world, firmware_dftl::STEPS).unwrap();
+    assert_eq!(
+        format!("0x{host:016x}"),
+        target,
+        "host and Cortex-M4F DFTL hashes differ"
+    );
 }
 
 #[test]

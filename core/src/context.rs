@@ -5,7 +5,7 @@ use crate::collide::{Collider, Shape, MAX_COLLIDERS};
 use crate::effects::{Effect, Effects};
 use crate::head::Pose;
 use crate::math::{Real, Vec3};
-use crate::params::Params;
+use crate::params::{DftlCoefficients, Params, Solver};
 
 /// Per-step constants and the colliders placed for this step.
 #[derive(Clone, Debug)]
@@ -28,12 +28,35 @@ pub struct StepContext {
     pub colliders: [Shape; MAX_COLLIDERS],
     /// How many entries of `colliders` are in use (0 when `collisions` is off).
     pub collider_count: usize,
+    /// Wind acceleration this step, or zero when the effect is off (see [`Self::at_time`]).
+    pub wind: Vec3,
+    /// DFTL's coefficients at this `dt` (zero unless the solver is DFTL).
+    pub dftl: DftlCoefficients,
 }
 
 impl StepContext {
-    /// The context of a step that moves the head from `previous_head` to `head`.
+    /// The context of a step that moves the head from `previous_head` to `head`. Evaluates
+    /// DFTL's rescaled coefficients (two `powf`); callers stepping many times should compute
+    /// them once with [`crate::params::DftlParams::at_step`] and use [`Self::with_coefficients`].
     #[must_use]
     pub fn new(params: &Params, previous_head: Pose, head: Pose, colliders: &[Collider]) -> Self {
+        let dftl = if params.solver == Solver::Dftl {
+            params.dftl.at_step(params.dt)
+        } else {
+            DftlCoefficients::default()
+        };
+        Self::with_coefficients(params, dftl, previous_head, head, colliders)
+    }
+
+    /// As [`Self::new`] with DFTL's coefficients computed once at set-up.
+    #[must_use]
+    pub fn with_coefficients(
+        params: &Params,
+        dftl: DftlCoefficients,
+        previous_head: Pose,
+        head: Pose,
+        colliders: &[Collider],
+    ) -> Self {
         let effects = params.effects;
         let mut placed = [Shape::Plane {
             point: Vec3::ZERO,
@@ -64,7 +87,19 @@ impl StepContext {
             },
             colliders: placed,
             collider_count,
+            wind: Vec3::ZERO,
+            dftl,
         }
+        .at_time(0.0)
+    }
+
+    /// Sets the step's time `t` (its end, s), which the wind's gusts depend on.
+    #[must_use]
+    pub fn at_time(mut self, t: Real) -> Self {
+        if self.effects.contains(Effect::Wind) {
+            self.wind = crate::forces::wind_acceleration(&self.params.wind, t);
+        }
+        self
     }
 
     /// The colliders in use this step.

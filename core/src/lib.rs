@@ -20,16 +20,26 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
+// Unit tests print the figures they measure and use std's float functions; the library never
+// links std.
+#[cfg(test)]
+extern crate std; // cfg(test) only
+
 pub mod collide;
 pub mod context;
+pub mod dftl;
 pub mod effects;
 pub mod error;
+pub mod follow;
+pub mod forces;
+pub mod frames;
 pub mod grab;
 pub mod guard;
 pub mod hash;
 pub mod head;
 pub mod math;
 pub mod params;
+pub mod precision;
 pub mod projection;
 pub mod report;
 pub mod rod;
@@ -42,8 +52,8 @@ pub use effects::{Effect, Effects};
 pub use error::{BuildError, CapacityError, Error, ParamError};
 pub use grab::{Grab, GrabStatus};
 pub use head::{Pose, Shake};
-pub use math::{DefaultMath, Libm, Math, Real, Vec3};
-pub use params::{Mode, Params, Solver};
+pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
+pub use params::{DftlCoefficients, DftlParams, Mode, Params, Solver, WindParams};
 pub use projection::project_constraints;
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};

@@ -159,6 +159,31 @@ pub fn quat_from_axis_angle<M: Math>(axis: Vec3, angle: Real) -> Quat {
     Quat::from_xyzw(axis.x * s, axis.y * s, axis.z * s, c)
 }
 
+/// Minimal rotation (no twist) taking the unit vector `a` to the unit vector `b`, not yet
+/// normalised: `(w, xyz) = (1 + a·b, a × b)` has norm `√(2(1 + a·b))`. Callers normalise the
+/// product they build with it once (DFTL frame transport), saving a square root per node.
+#[inline(always)]
+pub fn quat_between_unnormalized(a: Vec3, b: Vec3) -> Quat {
+    let c = a.cross(b);
+    Quat::from_xyzw(c.x, c.y, c.z, 1.0 + a.dot(b))
+}
+
+/// Set-up only (never per step): a per-step relaxation fraction given at the step
+/// `reference_dt`, rescaled to the step `dt` so the relaxation time stays the same:
+/// `s(Δt) = 1 − (1 − s_ref)^{Δt/Δt_ref}` (Sánchez-Banderas 2015 give `s_g`, `s_l` at 16 ms).
+/// `powf` is `libm`'s, so the bits are the same on every target.
+#[must_use]
+pub fn relaxation_at_step(s_ref: Real, dt: Real, reference_dt: Real) -> Real {
+    if s_ref >= 1.0 {
+        // Full projection every step, whatever the step: (1 − 1)^x = 0.
+        return 1.0;
+    }
+    if s_ref <= 0.0 || s_ref.is_nan() {
+        return 0.0;
+    }
+    1.0 - libm::powf(1.0 - s_ref, dt / reference_dt)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -180,6 +205,37 @@ mod tests {
         assert!((rotate(q, v) - q * v).length() < 1e-6);
         let p = quat_mul(q, quat_conjugate(q));
         assert!((p.w - 1.0).abs() < 1e-6 && p.x.abs() < 1e-6);
+    }
+
+    #[test]
+    fn relaxation_keeps_the_relaxation_time() {
+        // DESIGN.md: 0.3 → 0.022 and 0.1 → 0.0066 at 1 ms from 16 ms.
+        assert!((relaxation_at_step(0.3, 0.001, 0.016) - 0.022).abs() < 5e-4);
+        assert!((relaxation_at_step(0.1, 0.001, 0.016) - 0.0066).abs() < 5e-5);
+        // Sixteen 1 ms steps leave what one 16 ms step leaves: (1 − s)^16 = 1 − s_ref.
+        let s = relaxation_at_step(0.3, 0.001, 0.016);
+        let mut left = 1.0_f64;
+        for _ in 0..16 {
+            left *= 1.0 - f64::from(s);
+        }
+        assert!((left - 0.7).abs() < 1e-5, "{left}");
+        assert_eq!(
+            relaxation_at_step(0.3, 0.016, 0.016),
+            1.0 - libm::powf(0.7, 1.0)
+        );
+        assert_eq!(relaxation_at_step(1.0, 0.001, 0.016), 1.0);
+        assert_eq!(relaxation_at_step(0.0, 0.001, 0.016), 0.0);
+    }
+
+    #[test]
+    fn minimal_rotation_takes_a_to_b() {
+        let a = Vec3::new(0.0, 0.6, 0.8);
+        let b = Vec3::new(1.0, 0.0, 0.0);
+        let q = quat_normalize::<Libm>(quat_between_unnormalized(a, b));
+        assert!((rotate(q, a) - b).length() < 1e-6);
+        // Twist-free: the common normal a × b is left alone.
+        let n = a.cross(b).normalize();
+        assert!((rotate(q, n) - n).length() < 1e-6);
     }
 
     #[cfg(feature = "micromath")]

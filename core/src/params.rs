@@ -3,6 +3,7 @@
 use crate::effects::{Effect, Effects};
 use crate::error::ParamError;
 use crate::math::{Real, Vec3};
+pub use crate::rod::twist::TwistMethod;
 
 /// Which model steps the strands.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -30,7 +31,9 @@ impl Solver {
     pub const fn supports(self, effect: Effect) -> bool {
         match self {
             Solver::Rod => !matches!(effect, Effect::Shape),
-            Solver::Dftl => !matches!(effect, Effect::Bending | Effect::Twist),
+            // DFTL has no grab constraint (its single root-to-tip pass cannot hold a middle
+            // node): refused, not silently ignored.
+            Solver::Dftl => !matches!(effect, Effect::Bending | Effect::Twist | Effect::Grabs),
         }
     }
 }
@@ -65,6 +68,13 @@ pub struct RodParams {
     pub projection_iterations: u16,
     /// Relative tolerance `max |e·e − ê·ê| / ê·ê`. Default 1e-6.
     pub projection_tolerance: Real,
+    /// The quasistatic twist (`twist` effect): hair-optimised (Sec. 6.2) or Newton (BWR08).
+    /// Default hair-optimised.
+    pub twist: TwistMethod,
+    /// Iteration cap of the Newton twist. Default 10.
+    pub newton_iterations: u16,
+    /// Newton twist tolerance on the largest angle update, rad. Default 1e-6.
+    pub newton_tolerance: Real,
 }
 
 /// Parameters of the DFTL solver (Sánchez-Banderas 2015, Sec. 3.1).
@@ -80,6 +90,62 @@ pub struct DftlParams {
     pub local_shape: Real,
     /// The step at which `s_g`, `s_l` are given. Default 0.016 s.
     pub reference_dt: Real,
+    /// How much `s_g` fades from root to tip, linearly with rest distance from the root:
+    /// `s_g(i) = s_g · (1 − fade · d_i / L)`. 0 (default) keeps it constant, 1 reaches 0 at
+    /// the tip.
+    pub global_shape_fade: Real,
+    /// The same for `s_l`. Default 0.
+    pub local_shape_fade: Real,
+}
+
+impl DftlParams {
+    /// The per-step fractions at the step `dt`, computed once at set-up (`World::configure`),
+    /// never per step: `s(Δt) = 1 − (1 − s_ref)^{Δt/Δt_ref}` (DESIGN.md, DFTL with shape).
+    /// `s_d` is a fraction of the correction fed back and is not rescaled.
+    #[must_use]
+    pub fn at_step(&self, dt: Real) -> DftlCoefficients {
+        DftlCoefficients {
+            damping: self.damping,
+            global_shape: crate::math::relaxation_at_step(self.global_shape, dt, self.reference_dt),
+            local_shape: crate::math::relaxation_at_step(self.local_shape, dt, self.reference_dt),
+            global_shape_fade: self.global_shape_fade,
+            local_shape_fade: self.local_shape_fade,
+        }
+    }
+}
+
+/// DFTL's coefficients at the world's step (see [`DftlParams::at_step`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct DftlCoefficients {
+    /// `s_d`, as given.
+    pub damping: Real,
+    /// `s_g` per step at the world's `dt`, at the root.
+    pub global_shape: Real,
+    /// `s_l` per step at the world's `dt`, at the root.
+    pub local_shape: Real,
+    /// As [`DftlParams::global_shape_fade`].
+    pub global_shape_fade: Real,
+    /// As [`DftlParams::local_shape_fade`].
+    pub local_shape_fade: Real,
+}
+
+/// Wind, an external acceleration on every free node of both solvers (used when `wind` is on):
+/// `a(t) = direction · strength · (1 + gust · n(t))`, with `n` a seeded, smooth value noise of
+/// time in `[−1, 1]` (see `forces::wind_acceleration`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct WindParams {
+    /// Unit direction the wind blows towards (world frame). Default +x.
+    pub direction: Vec3,
+    /// Mean acceleration, m/s². Default 2.
+    pub strength: Real,
+    /// Gust amplitude as a fraction of `strength`, 0 to 10. Default 0.5.
+    pub gust: Real,
+    /// Gust frequency, Hz (how often the noise picks a new value), 0 to 1000. Default 1.5.
+    pub gust_frequency: Real,
+    /// Seed of the gust noise: same seed, same gusts on every target.
+    pub seed: u32,
 }
 
 /// Everything a world needs to know besides its strands, colliders and grabs.
@@ -101,6 +167,8 @@ pub struct Params {
     pub rod: RodParams,
     /// DFTL parameters.
     pub dftl: DftlParams,
+    /// Wind (used when `wind` is on).
+    pub wind: WindParams,
 }
 
 /// Largest time step any scene may use, s.
@@ -120,12 +188,24 @@ impl Params {
         rod: RodParams {
             projection_iterations: 8,
             projection_tolerance: 1.0e-6,
+            twist: TwistMethod::HairOptimised,
+            newton_iterations: 10,
+            newton_tolerance: 1.0e-6,
         },
         dftl: DftlParams {
             damping: 0.9,
             global_shape: 0.1,
             local_shape: 0.3,
             reference_dt: 0.016,
+            global_shape_fade: 0.0,
+            local_shape_fade: 0.0,
+        },
+        wind: WindParams {
+            direction: Vec3::X,
+            strength: 2.0,
+            gust: 0.5,
+            gust_frequency: 1.5,
+            seed: 0x5EED,
         },
     };
 
@@ -163,6 +243,16 @@ impl Params {
             "rod.projection_tolerance",
             "a finite value > 0",
         )?;
+        range(
+            self.rod.newton_iterations >= 1 && self.rod.newton_iterations <= 100,
+            "rod.newton_iterations",
+            "1 to 100",
+        )?;
+        range(
+            self.rod.newton_tolerance.is_finite() && self.rod.newton_tolerance > 0.0,
+            "rod.newton_tolerance",
+            "a finite value > 0 rad",
+        )?;
         let fraction = |v: Real| v.is_finite() && (0.0..=1.0).contains(&v);
         range(fraction(self.dftl.damping), "dftl.damping", "0 to 1")?;
         range(
@@ -180,13 +270,38 @@ impl Params {
             "dftl.reference_dt",
             "a finite value > 0 s",
         )?;
-        if self.solver == Solver::Dftl {
-            // An error, not a silent fallback, until the DFTL solver lands.
-            return Err(ParamError::OutOfRange {
-                field: "solver",
-                allowed: "\"rod\" (the dftl solver is not built yet)",
-            });
-        }
+        range(
+            fraction(self.dftl.global_shape_fade),
+            "dftl.global_shape_fade",
+            "0 to 1",
+        )?;
+        range(
+            fraction(self.dftl.local_shape_fade),
+            "dftl.local_shape_fade",
+            "0 to 1",
+        )?;
+        let wind = &self.wind;
+        range(
+            crate::math::is_finite(wind.direction)
+                && (wind.direction.length_squared() - 1.0).abs() < 1e-4,
+            "wind.direction",
+            "a finite unit vector",
+        )?;
+        range(
+            wind.strength.is_finite() && wind.strength >= 0.0,
+            "wind.strength",
+            "a finite value >= 0 m/s2",
+        )?;
+        range(
+            wind.gust.is_finite() && (0.0..=10.0).contains(&wind.gust),
+            "wind.gust",
+            "0 to 10",
+        )?;
+        range(
+            wind.gust_frequency.is_finite() && (0.0..=1000.0).contains(&wind.gust_frequency),
+            "wind.gust_frequency",
+            "0 to 1000 Hz",
+        )?;
         if let Some(effect) = self.effects.unsupported_by(self.solver) {
             return Err(ParamError::UnsupportedEffect {
                 effect: effect.name(),
@@ -245,7 +360,37 @@ mod tests {
             solver: Solver::Dftl,
             ..Params::DEFAULT
         };
-        assert!(dftl.validate().is_err());
+        assert_eq!(dftl.validate(), Ok(()));
+        let grabs_on_dftl = Params {
+            effects: Effects::NONE.with(Effect::Grabs),
+            ..dftl
+        };
+        assert!(matches!(
+            grabs_on_dftl.validate(),
+            Err(ParamError::UnsupportedEffect {
+                effect: "grabs",
+                ..
+            })
+        ));
+        let sideways = Params {
+            wind: WindParams {
+                direction: Vec3::new(1.0, 1.0, 0.0),
+                ..Params::DEFAULT.wind
+            },
+            ..Params::DEFAULT
+        };
+        assert!(sideways.validate().is_err());
+        let mut newton = Params::DEFAULT;
+        newton.rod.twist = TwistMethod::Newton;
+        assert_eq!(newton.validate(), Ok(()));
+        newton.rod.newton_iterations = 0;
+        assert!(matches!(
+            newton.validate(),
+            Err(ParamError::OutOfRange {
+                field: "rod.newton_iterations",
+                ..
+            })
+        ));
         let shape_on_rod = Params {
             effects: Effects::NONE.with(Effect::Shape),
             ..Params::DEFAULT

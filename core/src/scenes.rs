@@ -7,13 +7,17 @@ use crate::error::Error;
 use crate::head::{Pose, Shake};
 use crate::math::{Math, Real, Vec3};
 use crate::params::{Mode, Params};
+use crate::report::StepReport;
 use crate::strand::{Material, Strand};
 use crate::world::{StepInput, World};
 
 /// The scene the firmware example (`firmware/`) runs under QEMU and the harness runs as the
-/// built-in scene `firmware`: a few strands on a head shaking at 10 rad/s.
+/// built-in scene `firmware`: a few curved rod strands on a head shaking at 10 rad/s, with every
+/// stage of the rod solver on — bending, twist, inextensibility, head collisions and a grab that
+/// drags one strand's tip around a circle.
 pub mod firmware {
     use super::*;
+    use crate::grab::Grab;
 
     /// Strands in the scene.
     pub const STRANDS: usize = 4;
@@ -22,19 +26,30 @@ pub mod firmware {
     /// Steps the firmware runs before it prints the hash.
     pub const STEPS: u32 = 1000;
 
-    /// The scene's parameters: rod solver, 1 ms, fixed-cost mode.
+    /// The scene's parameters: rod solver, 1 ms, fixed-cost mode, every rod effect on.
     #[must_use]
     pub fn params() -> Params {
         Params {
-            effects: Effects::from_slice(&[Effect::Gravity, Effect::Drag, Effect::Collisions]),
+            effects: Effects::from_slice(&[
+                Effect::Gravity,
+                Effect::Drag,
+                Effect::Bending,
+                Effect::Twist,
+                Effect::Inextensibility,
+                Effect::Collisions,
+                Effect::Grabs,
+            ]),
             mode: Mode::FixedCost,
             drag: 2.0e-7,
             ..Params::DEFAULT
         }
     }
 
+    /// Node of strand 0 the grab holds (its tip).
+    pub const GRABBED_NODE: u32 = 11;
+
     /// Fills an empty world with the scene: `STRANDS` strands of 12 to 15 nodes, 1 cm apart,
-    /// rooted on a 5 cm sphere that moves with the head.
+    /// rooted on a 5 cm sphere that moves with the head; strand 0's tip is grabbed.
     pub fn build<M: Math>(world: &mut World<STRANDS, NODES, M>) -> Result<(), Error> {
         world.configure(params())?;
         world.add_collider(Collider {
@@ -47,13 +62,141 @@ pub mod firmware {
         for s in 0..STRANDS {
             let nodes = 12 + s % 4;
             let angle = s as Real * 0.4 - 0.6;
-            let direction = Vec3::new(angle, 1.0, 0.3 * angle).normalize();
+            let direction = Vec3::new(angle, 1.0, 0.3 * angle);
+            let direction = direction * (1.0 / M::length(direction));
             let root = direction * 0.05;
             let mut points = [Vec3::ZERO; NODES];
             for (i, p) in points.iter_mut().enumerate().take(nodes) {
                 // Out along the normal, then curving sideways: not a straight line.
                 let bend = Vec3::new(0.002 * (i * i) as Real, 0.0, 0.0);
                 *p = root + direction * (0.01 * i as Real) + bend;
+            }
+            world.add_strand(Strand::from_polyline(
+                &points[..nodes],
+                &Material::HUMAN_HAIR,
+            )?)?;
+        }
+        world.add_grab(Grab::new(0, GRABBED_NODE, grab_target::<M>(0), 0.05))?;
+        Ok(())
+    }
+
+    /// Where the grab holds strand 0's tip before step `k`: a 1 cm circle at 2 Hz about the
+    /// tip's rest position.
+    #[must_use]
+    pub fn grab_target<M: Math>(k: u32) -> Vec3 {
+        let t = k as Real * params().dt;
+        let (s, c) = M::sin_cos(2.0 * core::f32::consts::PI * 2.0 * t);
+        let direction = Vec3::new(-0.6, 1.0, -0.18);
+        let direction = direction * (1.0 / M::length(direction));
+        let tip = direction * (0.05 + 0.01 * GRABBED_NODE as Real)
+            + Vec3::new(0.002 * (GRABBED_NODE * GRABBED_NODE) as Real, 0.0, 0.0);
+        tip + Vec3::new(0.01 * (c - 1.0), 0.0, 0.01 * s)
+    }
+
+    /// The input of step `k` (0-based): the head shaking at 10 rad/s, pose at `t = (k+1) dt`.
+    #[must_use]
+    pub fn input<M: Math>(k: u32) -> StepInput<'static> {
+        let t = (k + 1) as Real * params().dt;
+        StepInput {
+            head: Shake::TEN_RAD_PER_S.pose_at::<M>(t),
+            accelerations: None,
+        }
+    }
+
+    /// Builds the scene, runs `steps` steps and returns the state hash.
+    pub fn run<M: Math>(world: &mut World<STRANDS, NODES, M>, steps: u32) -> Result<u64, Error> {
+        build(world)?;
+        for k in 0..steps {
+            step(world, k);
+        }
+        Ok(world.state_hash())
+    }
+
+    /// Step `k` (0-based) of the scene: the grab moves, the head shakes.
+    pub fn step<M: Math>(world: &mut World<STRANDS, NODES, M>, k: u32) -> StepReport {
+        world.set_grab_target(0, grab_target::<M>(k + 1));
+        world.step(&input::<M>(k))
+    }
+
+    /// The head's pose before the first step.
+    pub const START: Pose = Pose::IDENTITY;
+}
+
+/// The DFTL scene for the firmware example and the harness (built-in scene `firmware-dftl`):
+/// the same head shaking at 10 rad/s, wavy strands with global and local shape, gusty wind,
+/// gravity and drag, a head sphere and a floor plane.
+pub mod firmware_dftl {
+    use super::*;
+    use crate::params::{Solver, WindParams};
+
+    /// Strands in the scene.
+    pub const STRANDS: usize = 8;
+    /// Node capacity per strand.
+    pub const NODES: usize = 16;
+    /// Steps the firmware runs before it prints the hash.
+    pub const STEPS: u32 = 1000;
+
+    /// The scene's parameters: DFTL, 1 ms, shape and wind on.
+    #[must_use]
+    pub fn params() -> Params {
+        let mut params = Params {
+            solver: Solver::Dftl,
+            effects: Effects::from_slice(&[
+                Effect::Gravity,
+                Effect::Drag,
+                Effect::Inextensibility,
+                Effect::Collisions,
+                Effect::Shape,
+                Effect::Wind,
+            ]),
+            mode: Mode::FixedCost,
+            drag: 2.0e-7,
+            wind: WindParams {
+                direction: Vec3::new(0.6, 0.0, 0.8),
+                strength: 3.0,
+                gust: 0.8,
+                gust_frequency: 2.0,
+                seed: 0x00C0_FFEE,
+            },
+            ..Params::DEFAULT
+        };
+        params.dftl.global_shape_fade = 0.5;
+        params
+    }
+
+    /// Fills an empty world with the scene: `STRANDS` wavy strands of 12 to 16 nodes, 8 mm
+    /// segments, rooted on a 5 cm sphere that moves with the head, above a floor 7.5 cm down that
+    /// the sagging tips reach.
+    pub fn build<M: Math>(world: &mut World<STRANDS, NODES, M>) -> Result<(), Error> {
+        world.configure(params())?;
+        world.add_collider(Collider {
+            shape: Shape::Sphere {
+                centre: Vec3::ZERO,
+                radius: 0.05,
+            },
+            attached_to_head: true,
+        })?;
+        world.add_collider(Collider {
+            shape: Shape::Plane {
+                point: Vec3::new(0.0, -0.075, 0.0),
+                normal: Vec3::Y,
+            },
+            attached_to_head: false,
+        })?;
+        for s in 0..STRANDS {
+            let nodes = 12 + s % 5;
+            let angle = s as Real * 0.785;
+            let (sin, cos) = M::sin_cos(angle);
+            // Alternately up and sideways-down (those reach towards the floor).
+            let up = if s % 2 == 0 { 0.7 } else { -0.35 };
+            let direction = Vec3::new(0.7 * cos, up, 0.7 * sin);
+            let direction = direction * (1.0 / M::length(direction));
+            let side = Vec3::new(-sin, 0.0, cos);
+            let mut points = [Vec3::ZERO; NODES];
+            for (i, p) in points.iter_mut().enumerate().take(nodes) {
+                // Out along the normal with a 3 mm wave: a styled strand, not a straight line.
+                let (wave, _) = M::sin_cos(1.3 * i as Real);
+                *p = direction * (0.05 + 0.008 * i as Real) + side * (0.003 * wave);
             }
             world.add_strand(Strand::from_polyline(
                 &points[..nodes],

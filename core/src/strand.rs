@@ -7,6 +7,7 @@
 
 use crate::error::BuildError;
 use crate::math::{Libm, Math, Real, Vec3};
+use crate::rod::energy::{rest_root_frame, RodRest};
 
 /// Shortest rest segment a strand may have, m.
 pub const MIN_SEGMENT_LENGTH: Real = 1.0e-6;
@@ -114,6 +115,10 @@ pub struct RestStrand<const N: usize> {
     pub minor_axis_penalty: Real,
     /// Twist stiffness `β`, N·m².
     pub twist_stiffness: Real,
+    /// DFTL's rest frames and local rest vectors (Sánchez-Banderas 2015 Sec. 3.1).
+    pub dftl: crate::dftl::DftlRest<N>,
+    /// The rod energies' rest data (`l̂`, `ω̂`, `m̂`, `θ̂`, the stable time step).
+    pub rod: RodRest<N>,
 }
 
 /// What a step changes. Only this is hashed, snapshotted and rolled back.
@@ -170,6 +175,8 @@ impl<const N: usize> Strand<N> {
             bending_stiffness: [0.0; N],
             minor_axis_penalty: material.minor_axis_penalty,
             twist_stiffness: material.twist_stiffness(),
+            dftl: crate::dftl::DftlRest::from_polyline::<Libm>(&[]),
+            rod: RodRest::compute::<Libm>(&[], 0.0, 1.0, 0.0, 1.0),
         };
         rest.position[..nodes].copy_from_slice(points);
         let lambda = material.linear_density();
@@ -195,11 +202,21 @@ impl<const N: usize> Strand<N> {
         for i in 0..nodes {
             rest.inverse_mass[i] = 1.0 / rest.mass[i];
         }
+        rest.dftl = crate::dftl::DftlRest::from_polyline::<Libm>(points);
+        // Segments are checked above: the rod's rest data divides by their lengths.
+        rest.rod = RodRest::compute::<Libm>(
+            points,
+            alpha,
+            material.minor_axis_penalty,
+            material.twist_stiffness(),
+            lambda,
+        );
         let mut state = StrandState {
             position: [Vec3::ZERO; N],
             velocity: [Vec3::ZERO; N],
-            theta: [0.0; N],
-            root_frame: perpendicular_unit(points[1] - points[0]),
+            // The rest material frames: a strand starts at rest for the twist solvers too.
+            theta: rest.rod.rest_theta,
+            root_frame: rest_root_frame::<Libm>(points[0], points[1], rest.segment_length[0]),
         };
         state.position[..nodes].copy_from_slice(points);
         Ok(Strand { rest, state })

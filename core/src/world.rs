@@ -12,8 +12,8 @@ use crate::context::StepContext;
 use crate::error::{CapacityError, Error, ParamError};
 use crate::grab::{Grab, GrabStatus, MAX_GRABS};
 use crate::head::Pose;
-use crate::math::{DefaultMath, Math, Vec3};
-use crate::params::{Params, Solver};
+use crate::math::{DefaultMath, Math, Real, Vec3};
+use crate::params::{DftlCoefficients, Params, Solver};
 use crate::report::{Flags, Stage, StepReport};
 use crate::strand::Strand;
 
@@ -54,8 +54,7 @@ pub fn step_strands<M: Math, const N: usize>(
                 strand_accelerations,
                 report,
             ),
-            // Refused by `Params::validate` until the DFTL solver lands.
-            Solver::Dftl => {}
+            Solver::Dftl => crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report),
         }
         // 3. Guard: nothing non-finite leaves the step.
         crate::guard::check(strand, &last_good, index, report);
@@ -68,6 +67,8 @@ pub fn step_strands<M: Math, const N: usize>(
 #[derive(Clone, Debug)]
 pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     params: Params,
+    /// DFTL's coefficients at `params.dt`, computed once in `configure` (never per step).
+    dftl: DftlCoefficients,
     strands: heapless::Vec<Strand<N>, S>,
     colliders: heapless::Vec<Collider, MAX_COLLIDERS>,
     grabs: heapless::Vec<Grab, MAX_GRABS>,
@@ -88,6 +89,13 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub const fn new() -> Self {
         World {
             params: Params::DEFAULT,
+            dftl: DftlCoefficients {
+                damping: 0.0,
+                global_shape: 0.0,
+                local_shape: 0.0,
+                global_shape_fade: 0.0,
+                local_shape_fade: 0.0,
+            },
             strands: heapless::Vec::new(),
             colliders: heapless::Vec::new(),
             grabs: heapless::Vec::new(),
@@ -108,6 +116,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub fn configure(&mut self, params: Params) -> Result<(), ParamError> {
         params.validate()?;
         self.params = params;
+        self.dftl = params.dftl.at_step(params.dt);
         Ok(())
     }
 
@@ -231,7 +240,15 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             report.flags.insert(Flags::BAD_INPUT);
             self.head
         };
-        let ctx = StepContext::new(&self.params, self.head, head, &self.colliders);
+        let time = (self.steps + 1) as Real * self.params.dt;
+        let ctx = StepContext::with_coefficients(
+            &self.params,
+            self.dftl,
+            self.head,
+            head,
+            &self.colliders,
+        )
+        .at_time(time);
         step_strands::<M, N>(
             &ctx,
             &mut self.strands,

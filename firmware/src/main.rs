@@ -11,7 +11,7 @@ use core::cell::RefCell;
 use cortex_m::interrupt::Mutex;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::{debug, hprintln};
-use hairsim_core::scenes::firmware;
+use hairsim_core::scenes::{firmware, firmware_dftl};
 use hairsim_core::{Libm, Math, Real, World};
 
 /// The math backend of this firmware: the FPU's `VSQRT` for square roots, `libm` (or, with the
@@ -58,15 +58,22 @@ impl Math for Vsqrt {
 }
 
 type FirmwareWorld = World<{ firmware::STRANDS }, { firmware::NODES }, Vsqrt>;
+type DftlWorld = World<{ firmware_dftl::STRANDS }, { firmware_dftl::NODES }, Vsqrt>;
 
-/// The world lives in a `static`: no heap, its size known at link time.
+/// The worlds live in `static`s: no heap, their sizes known at link time.
 static WORLD: Mutex<RefCell<FirmwareWorld>> = Mutex::new(RefCell::new(World::new()));
+static DFTL_WORLD: Mutex<RefCell<DftlWorld>> = Mutex::new(RefCell::new(World::new()));
 
 #[entry]
 fn main() -> ! {
     let code = cortex_m::interrupt::free(|cs| {
-        let mut world = WORLD.borrow(cs).borrow_mut();
-        run(&mut world)
+        let rod = run(&mut WORLD.borrow(cs).borrow_mut());
+        let dftl = run_dftl(&mut DFTL_WORLD.borrow(cs).borrow_mut());
+        if rod == debug::EXIT_SUCCESS {
+            dftl
+        } else {
+            rod
+        }
     });
     debug::exit(code);
     #[allow(clippy::empty_loop)]
@@ -82,7 +89,32 @@ fn run(world: &mut FirmwareWorld) -> debug::ExitStatus {
         Ok(hash) => {
             let finite = world.strands().iter().all(|s| s.is_finite());
             hprintln!(
-                "scene firmware steps {} strands {} finite {} state_hash 0x{:016x}",
+                "scene firmware steps {} strands {} finite {} grab {:?} state_hash 0x{:016x}",
+                world.steps(),
+                world.strands().len(),
+                finite,
+                world.grabs().first().map(|g| g.status),
+                hash
+            );
+            if finite {
+                debug::EXIT_SUCCESS
+            } else {
+                debug::EXIT_FAILURE
+            }
+        }
+        Err(e) => {
+            hprintln!("error: building the firmware scene: {}", e);
+            debug::EXIT_FAILURE
+        }
+    }
+}
+
+fn run_dftl(world: &mut DftlWorld) -> debug::ExitStatus {
+    match firmware_dftl::run(world, firmware_dftl::STEPS) {
+        Ok(hash) => {
+            let finite = world.strands().iter().all(|s| s.is_finite());
+            hprintln!(
+                "scene firmware-dftl steps {} strands {} finite {} state_hash 0x{:016x}",
                 world.steps(),
                 world.strands().len(),
                 finite,
@@ -95,7 +127,7 @@ fn run(world: &mut FirmwareWorld) -> debug::ExitStatus {
             }
         }
         Err(e) => {
-            hprintln!("error: building the firmware scene: {}", e);
+            hprintln!("error: building the firmware-dftl scene: {}", e);
             debug::EXIT_FAILURE
         }
     }

@@ -5,7 +5,11 @@
 //! record and replay, hair files in and out, pictures and studies.
 
 pub mod builtin;
+pub mod export;
+pub mod hairfile;
+pub mod picture;
 pub mod run;
+pub mod sph;
 pub mod summary;
 
 pub use hairsim_core as core;

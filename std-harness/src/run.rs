@@ -69,9 +69,8 @@ fn run_firmware<M: Math>(options: &RunOptions) -> Result<Summary> {
     let mut totals = Totals::default();
     let mut times = Vec::with_capacity(steps as usize);
     for k in 0..steps {
-        let input = firmware::input::<M>(k as u32);
         let start = Instant::now();
-        let report = world.step(&input);
+        let report = firmware::step(&mut world, k as u32);
         times.push(start.elapsed().as_secs_f64());
         totals.add(&report);
     }

@@ -1,0 +1,228 @@
+//! The arithmetic the rod's frame and energy kernels are written in.
+//!
+//! The kernels are generic over a [`Precision`]: every [`Math`] backend is one (`f32`, glam
+//! `Vec3`, the backend's `sqrt`/`sin_cos`/`atan2`), which is what the step runs; [`F64`] is the
+//! same code in `f64` (`DVec3`, `libm`'s double functions). Finite-difference tests of forces
+//! and Hessians need it: in `f32` a central difference stalls near 1e-3 relative error, in
+//! `f64` it reaches 1e-7, so a sign or factor error cannot hide in the noise.
+//!
+//! Only the operations the kernels use are in the traits; glam's inherent methods of the same
+//! names (`dot`, `cross`) sum left to right in scalar code on every target.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+
+use glam::DVec3;
+
+use crate::math::{Math, Real, Vec3};
+
+/// A floating-point scalar: `f32` or `f64`.
+pub trait Scalar:
+    Copy
+    + Debug
+    + Default
+    + PartialOrd
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + 'static
+{
+    /// 0.
+    const ZERO: Self;
+    /// 1.
+    const ONE: Self;
+    /// π.
+    const PI: Self;
+    /// The `f32` value `x` in this precision (exact).
+    fn of(x: f32) -> Self;
+    /// The value rounded to `f32`.
+    fn to_f32(self) -> f32;
+    /// `|x|`.
+    fn abs(self) -> Self;
+    /// Largest integer `≤ x` (exact, the same bits on every target).
+    fn floor(self) -> Self;
+    /// Whether the value is neither infinite nor NaN.
+    fn is_finite(self) -> bool;
+}
+
+impl Scalar for f32 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const PI: Self = core::f32::consts::PI;
+    #[inline(always)]
+    fn of(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        libm::fabsf(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        libm::floorf(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f32::is_finite(self)
+    }
+}
+
+impl Scalar for f64 {
+    const ZERO: Self = 0.0;
+    const ONE: Self = 1.0;
+    const PI: Self = core::f64::consts::PI;
+    #[inline(always)]
+    fn of(x: f32) -> Self {
+        f64::from(x)
+    }
+    #[inline(always)]
+    fn to_f32(self) -> f32 {
+        self as f32
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        libm::fabs(self)
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        libm::floor(self)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        f64::is_finite(self)
+    }
+}
+
+/// A 3-vector over the scalar `R`: glam's `Vec3` or `DVec3`.
+pub trait Vector<R: Scalar>:
+    Copy
+    + Debug
+    + PartialEq
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Neg<Output = Self>
+    + Mul<R, Output = Self>
+    + AddAssign
+    + SubAssign
+    + 'static
+{
+    /// The zero vector.
+    const ZERO: Self;
+    /// `x + y + z` products summed left to right.
+    fn dot(self, other: Self) -> R;
+    /// The cross product.
+    fn cross(self, other: Self) -> Self;
+}
+
+impl Vector<f32> for Vec3 {
+    const ZERO: Self = Vec3::ZERO;
+    #[inline(always)]
+    fn dot(self, other: Self) -> f32 {
+        Vec3::dot(self, other)
+    }
+    #[inline(always)]
+    fn cross(self, other: Self) -> Self {
+        Vec3::cross(self, other)
+    }
+}
+
+impl Vector<f64> for DVec3 {
+    const ZERO: Self = DVec3::ZERO;
+    #[inline(always)]
+    fn dot(self, other: Self) -> f64 {
+        DVec3::dot(self, other)
+    }
+    #[inline(always)]
+    fn cross(self, other: Self) -> Self {
+        DVec3::cross(self, other)
+    }
+}
+
+/// A scalar, a vector and the few transcendental functions the kernels call.
+pub trait Precision: Copy + 'static {
+    /// The scalar type.
+    type R: Scalar;
+    /// The vector type.
+    type V: Vector<Self::R>;
+    /// Correctly rounded square root.
+    fn sqrt(x: Self::R) -> Self::R;
+    /// `(sin x, cos x)`.
+    fn sin_cos(x: Self::R) -> (Self::R, Self::R);
+    /// Four-quadrant arctangent of `y / x`.
+    fn atan2(y: Self::R, x: Self::R) -> Self::R;
+    /// The simulation's vector `v` in this precision.
+    fn vector(v: Vec3) -> Self::V;
+    /// `v` rounded to the simulation's vector.
+    fn to_vec3(v: Self::V) -> Vec3;
+}
+
+/// Every math backend is the `f32` precision the step runs in.
+impl<M: Math> Precision for M {
+    type R = Real;
+    type V = Vec3;
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        M::sqrt(x)
+    }
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        M::sin_cos(x)
+    }
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        M::atan2(y, x)
+    }
+    #[inline(always)]
+    fn vector(v: Vec3) -> Vec3 {
+        v
+    }
+    #[inline(always)]
+    fn to_vec3(v: Vec3) -> Vec3 {
+        v
+    }
+}
+
+/// Double precision with `libm`'s double functions: the reference for finite-difference tests
+/// and accuracy studies. Never used by the step.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct F64;
+
+impl Precision for F64 {
+    type R = f64;
+    type V = DVec3;
+    #[inline(always)]
+    fn sqrt(x: f64) -> f64 {
+        libm::sqrt(x)
+    }
+    #[inline(always)]
+    fn sin_cos(x: f64) -> (f64, f64) {
+        libm::sincos(x)
+    }
+    #[inline(always)]
+    fn atan2(y: f64, x: f64) -> f64 {
+        libm::atan2(y, x)
+    }
+    #[inline(always)]
+    fn vector(v: Vec3) -> DVec3 {
+        DVec3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z))
+    }
+    #[inline(always)]
+    fn to_vec3(v: DVec3) -> Vec3 {
+        Vec3::new(v.x as f32, v.y as f32, v.z as f32)
+    }
+}
+
+/// Length of `v` with the precision's square root.
+#[inline(always)]
+pub fn length<P: Precision>(v: P::V) -> P::R {
+    P::sqrt(v.dot(v))
+}

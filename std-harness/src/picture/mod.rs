@@ -1,0 +1,401 @@
+//! Pictures of frames: anti-aliased strands coloured root → tip over the colliders (sphere →
+//! disc, capsule → stadium, plane → edge line with its solid side shaded), seen through an
+//! orthographic camera; PNG stills and animated GIFs written a frame at a time.
+//!
+//! Drawn with `tiny-skia`. Strand segments and colliders are painted far to near (a painter's
+//! algorithm over segment midpoints and collider centres), so hair behind the head is hidden by
+//! it and hair in front covers it.
+
+mod camera;
+mod gif_writer;
+
+use hairsim_core::{Shape, Vec3};
+use tiny_skia::{
+    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Point, Stroke, Transform,
+};
+
+pub use camera::{Camera, View, MARGIN};
+pub use gif_writer::GifWriter;
+
+/// Why a picture could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum PictureError {
+    /// Width or height is zero or too large.
+    #[error("bad picture size {width}×{height} (1 ..= {max} pixels each way)")]
+    BadSize {
+        /// Requested width.
+        width: u32,
+        /// Requested height.
+        height: u32,
+        /// Largest allowed side.
+        max: u32,
+    },
+    /// PNG encoding failed.
+    #[error("PNG encoding: {0}")]
+    Png(String),
+    /// GIF encoding or writing failed.
+    #[error("GIF encoding: {0}")]
+    Gif(#[from] gif::EncodingError),
+}
+
+/// Largest picture side: GIF stores sizes in 16 bits, and this keeps a frame's buffer sane.
+pub const MAX_SIDE: u32 = 8192;
+
+/// Colours and widths. Colours are sRGB `[r, g, b]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Style {
+    /// Background.
+    pub background: [u8; 3],
+    /// Strand colour at the root.
+    pub root: [u8; 3],
+    /// Strand colour at the tip.
+    pub tip: [u8; 3],
+    /// Strand stroke width, pixels (≤ 1: anti-aliased hairlines, much faster to draw).
+    pub strand_width: f32,
+    /// Collider fill.
+    pub collider_fill: [u8; 3],
+    /// Collider outline (and a plane's edge line).
+    pub collider_edge: [u8; 3],
+    /// Shading of a plane's solid side.
+    pub plane_fill: [u8; 3],
+}
+
+impl Default for Style {
+    fn default() -> Self {
+        Style {
+            background: [250, 250, 247],
+            root: [58, 32, 18],
+            tip: [222, 168, 84],
+            strand_width: 1.0,
+            collider_fill: [196, 204, 214],
+            collider_edge: [96, 106, 120],
+            plane_fill: [226, 228, 222],
+        }
+    }
+}
+
+impl Style {
+    /// The default style with a strand width suited to `strands` strands: 2 px for a few
+    /// strands (≤ 64), 1.5 px up to 1000, 1 px beyond (where tiny-skia's fast anti-aliased
+    /// hairlines also keep a 150 000-segment frame near 0.2–0.5 s at 400×400).
+    #[must_use]
+    pub fn for_strand_count(strands: usize) -> Style {
+        let strand_width = match strands {
+            0..=64 => 2.0,
+            65..=1000 => 1.5,
+            _ => 1.0,
+        };
+        Style {
+            strand_width,
+            ..Style::default()
+        }
+    }
+}
+
+/// A brightness factor in 0.85 ..= 1.15 fixed by a strand's index (SplitMix64's finaliser).
+fn strand_tint(index: usize) -> f32 {
+    let mut z = (index as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^= z >> 31;
+    0.85 + 0.3 * ((z >> 40) as f32 / (1u64 << 24) as f32)
+}
+
+fn brighten(c: [u8; 3], factor: f32) -> [u8; 3] {
+    c.map(|v| (f32::from(v) * factor).round().clamp(0.0, 255.0) as u8)
+}
+
+fn colour([r, g, b]: [u8; 3]) -> Color {
+    Color::from_rgba8(r, g, b, 255)
+}
+
+fn mix(a: [u8; 3], b: [u8; 3], t: f32) -> [u8; 3] {
+    let t = t.clamp(0.0, 1.0);
+    let channel =
+        |i: usize| (f32::from(a[i]) + (f32::from(b[i]) - f32::from(a[i])) * t).round() as u8;
+    [channel(0), channel(1), channel(2)]
+}
+
+/// Number of steps in the root → tip colour ramp.
+const SHADES: usize = 32;
+
+/// Fewest colour steps along a strand: a strand with fewer segments is cut into pieces.
+const MIN_STEPS: usize = 8;
+
+/// A straight piece of a strand in one colour, in pixels.
+struct Piece {
+    colour: [u8; 3],
+    a: Point,
+    b: Point,
+}
+
+/// Strokes `pieces` (in strand order), each run of consecutive connected pieces of one colour
+/// as one polyline. Small paths matter: tiny-skia fills a stroked outline row by row over its
+/// bounding box, so paths gathering far-apart pieces cost far more than many local ones.
+fn draw_pieces(pixmap: &mut Pixmap, style: &Style, pieces: &[Piece]) {
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
+    let stroke = Stroke {
+        width: style.strand_width,
+        line_cap: LineCap::Round,
+        line_join: LineJoin::Round,
+        ..Stroke::default()
+    };
+    for run in pieces.chunk_by(|x, y| x.colour == y.colour && x.b == y.a) {
+        paint.set_color(colour(run[0].colour));
+        let mut path = PathBuilder::new();
+        path.move_to(run[0].a.x, run[0].a.y);
+        for piece in run {
+            path.line_to(piece.b.x, piece.b.y);
+        }
+        if let Some(path) = path.finish() {
+            pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+        }
+    }
+}
+
+/// A collider's picture.
+enum Solid {
+    Disc { centre: Point, radius: f32 },
+    Stadium { a: Point, b: Point, radius: f32 },
+}
+
+fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid) {
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
+    match *solid {
+        Solid::Disc { centre, radius } => {
+            if let Some(path) = PathBuilder::from_circle(centre.x, centre.y, radius.max(0.5)) {
+                paint.set_color(colour(style.collider_fill));
+                pixmap.fill_path(
+                    &path,
+                    &paint,
+                    FillRule::Winding,
+                    Transform::identity(),
+                    None,
+                );
+                paint.set_color(colour(style.collider_edge));
+                let edge = Stroke {
+                    width: 1.5,
+                    ..Stroke::default()
+                };
+                pixmap.stroke_path(&path, &paint, &edge, Transform::identity(), None);
+            }
+        }
+        Solid::Stadium { a, b, radius } => {
+            // The projection of a capsule is a stroke of its axis with round caps: outline
+            // first (a little wider), then the fill.
+            let mut path = PathBuilder::new();
+            path.move_to(a.x, a.y);
+            // A zero-length axis still gets round caps from a tiny nudge.
+            path.line_to(b.x + 1e-3, b.y);
+            if let Some(path) = path.finish() {
+                for (c, w) in [
+                    (style.collider_edge, 2.0 * radius + 3.0),
+                    (style.collider_fill, 2.0 * radius),
+                ] {
+                    paint.set_color(colour(c));
+                    let stroke = Stroke {
+                        width: w.max(1.0),
+                        line_cap: LineCap::Round,
+                        ..Stroke::default()
+                    };
+                    pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+                }
+            }
+        }
+    }
+}
+
+/// Draws one frame: `strands` (polylines, root first) and `colliders` (world coordinates —
+/// move head-attached ones with [`Shape::transformed`] first).
+///
+/// # Errors
+/// A bad size in `camera`.
+pub fn render<S: AsRef<[Vec3]>>(
+    strands: &[S],
+    colliders: &[Shape],
+    camera: &Camera,
+    style: &Style,
+) -> Result<Pixmap, PictureError> {
+    let (width, height) = (camera.width, camera.height);
+    let mut pixmap = match Pixmap::new(width, height) {
+        Some(p) if width <= MAX_SIDE && height <= MAX_SIDE => p,
+        _ => {
+            return Err(PictureError::BadSize {
+                width,
+                height,
+                max: MAX_SIDE,
+            })
+        }
+    };
+    pixmap.fill(colour(style.background));
+
+    // Planes are the ground and walls: behind everything.
+    for shape in colliders {
+        if let Shape::Plane { point, normal } = *shape {
+            draw_plane(&mut pixmap, camera, style, point, normal);
+        }
+    }
+
+    // Colliders far to near (a stable sort keeps the caller's order among equal depths).
+    let mut solids: Vec<(f32, Solid)> = Vec::new();
+    for shape in colliders {
+        match *shape {
+            Shape::Sphere { centre, radius } => {
+                let (c, depth) = camera.project(centre);
+                solids.push((
+                    depth,
+                    Solid::Disc {
+                        centre: c,
+                        radius: radius * camera.scale,
+                    },
+                ));
+            }
+            Shape::Capsule { a, b, radius } => {
+                let ((pa, da), (pb, db)) = (camera.project(a), camera.project(b));
+                solids.push((
+                    0.5 * (da + db),
+                    Solid::Stadium {
+                        a: pa,
+                        b: pb,
+                        radius: radius * camera.scale,
+                    },
+                ));
+            }
+            Shape::Plane { .. } => {}
+        }
+    }
+    solids.sort_by(|x, y| y.0.total_cmp(&x.0));
+
+    // Strand pieces are sorted into layers: layer k holds the pieces with k colliders behind
+    // them (by midpoint depth), drawn after those k colliders and before the rest. Each piece
+    // has one shade of the root → tip ramp (SHADES steps), made a little lighter or darker per
+    // strand (a fixed hash of its index) so dense hair shows strands rather than bands.
+    let mut layers: Vec<Vec<Piece>> = (0..=solids.len()).map(|_| Vec::new()).collect();
+    for (index, strand) in strands.iter().enumerate() {
+        let strand = strand.as_ref();
+        let tint = strand_tint(index);
+        let segments = strand.len().saturating_sub(1).max(1);
+        // Coarse strands are cut into pieces so the ramp shows at least MIN_STEPS steps; finer
+        // strands are not (every piece costs a stroke).
+        let pieces = MIN_STEPS.div_ceil(segments);
+        for (j, pair) in strand.windows(2).enumerate() {
+            if !(pair[0].is_finite() && pair[1].is_finite()) {
+                continue;
+            }
+            let ((a, da), (b, db)) = (camera.project(pair[0]), camera.project(pair[1]));
+            let depth = 0.5 * (da + db);
+            let layer = solids.iter().take_while(|(d, _)| *d > depth).count();
+            let Some(layer) = layers.get_mut(layer) else {
+                continue;
+            };
+            let at = |u: f32| Point::from_xy(a.x + (b.x - a.x) * u, a.y + (b.y - a.y) * u);
+            for q in 0..pieces {
+                let (u0, u1) = (q as f32 / pieces as f32, (q + 1) as f32 / pieces as f32);
+                let t = (j as f32 + 0.5 * (u0 + u1)) / segments as f32;
+                let shade = ((t * SHADES as f32) as usize).min(SHADES - 1);
+                let ramp = mix(style.root, style.tip, (shade as f32 + 0.5) / SHADES as f32);
+                layer.push(Piece {
+                    colour: brighten(ramp, tint),
+                    a: at(u0),
+                    b: at(u1),
+                });
+            }
+        }
+    }
+
+    for (k, layer) in layers.iter().enumerate() {
+        draw_pieces(&mut pixmap, style, layer);
+        if let Some((_, solid)) = solids.get(k) {
+            draw_solid(&mut pixmap, style, solid);
+        }
+    }
+    Ok(pixmap)
+}
+
+/// The plane's trace in the picture: its edge line and its solid side shaded. A plane facing the
+/// camera (normal along the view) has no edge to draw and is left out.
+fn draw_plane(pixmap: &mut Pixmap, camera: &Camera, style: &Style, point: Vec3, normal: Vec3) {
+    let (p, _) = camera.project(point);
+    // The normal in pixel space (y down).
+    let (nx, ny) = camera.project_direction(normal);
+    let n_len = (nx * nx + ny * ny).sqrt();
+    if n_len.is_nan() || n_len <= 1e-3 || !p.x.is_finite() || !p.y.is_finite() {
+        return;
+    }
+    let (nx, ny) = (nx / n_len, ny / n_len);
+    // Clip the picture's rectangle to the solid side, (q − p)·n ≤ 0 (Sutherland–Hodgman, one edge).
+    let (w, h) = (pixmap.width() as f32, pixmap.height() as f32);
+    let corners = [(0.0, 0.0), (w, 0.0), (w, h), (0.0, h)];
+    let side = |q: (f32, f32)| (q.0 - p.x) * nx + (q.1 - p.y) * ny;
+    let mut polygon = Vec::with_capacity(6);
+    for i in 0..4 {
+        let (a, b) = (corners[i], corners[(i + 1) % 4]);
+        let (sa, sb) = (side(a), side(b));
+        if sa <= 0.0 {
+            polygon.push(a);
+        }
+        if (sa <= 0.0) != (sb <= 0.0) {
+            let t = sa / (sa - sb);
+            polygon.push((a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1)));
+        }
+    }
+    let mut paint = Paint {
+        anti_alias: true,
+        ..Paint::default()
+    };
+    if polygon.len() >= 3 {
+        let mut path = PathBuilder::new();
+        path.move_to(polygon[0].0, polygon[0].1);
+        for q in &polygon[1..] {
+            path.line_to(q.0, q.1);
+        }
+        path.close();
+        if let Some(path) = path.finish() {
+            paint.set_color(colour(style.plane_fill));
+            pixmap.fill_path(
+                &path,
+                &paint,
+                FillRule::Winding,
+                Transform::identity(),
+                None,
+            );
+        }
+    }
+    // The edge: the line through p along (−ny, nx), long enough to cross the picture.
+    let reach = w + h;
+    let mut path = PathBuilder::new();
+    path.move_to(p.x - ny * reach, p.y + nx * reach);
+    path.line_to(p.x + ny * reach, p.y - nx * reach);
+    if let Some(path) = path.finish() {
+        paint.set_color(colour(style.collider_edge));
+        let stroke = Stroke {
+            width: 2.0,
+            ..Stroke::default()
+        };
+        pixmap.stroke_path(&path, &paint, &stroke, Transform::identity(), None);
+    }
+}
+
+/// Draws one frame and encodes it as PNG.
+///
+/// # Errors
+/// A bad size, or PNG encoding.
+pub fn render_png<S: AsRef<[Vec3]>>(
+    strands: &[S],
+    colliders: &[Shape],
+    camera: &Camera,
+    style: &Style,
+) -> Result<Vec<u8>, PictureError> {
+    render(strands, colliders, camera, style)?
+        .encode_png()
+        .map_err(|e| PictureError::Png(e.to_string()))
+}
+
+#[cfg(test)]
+mod tests;
