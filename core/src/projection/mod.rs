@@ -12,7 +12,7 @@
 //!    rows are eliminated first at their node (no fill), leaving the segments' tridiagonal
 //!    band, so contacts cost O(contacts) and never widen the band;
 //! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`, scaled down whole if it would move a node further
-//!    than the strand is long (a trust region that only garbage input ever meets).
+//!    than ten strand lengths (a trust region that only garbage input meets).
 //!
 //! Root coupling and grabs are *prescribed* nodes (`w = 0`, no rows): nodes 0 and 1 were set
 //! by root coupling, grabbed nodes are set to their targets here. Then
@@ -72,12 +72,16 @@ struct Workspace<const N: usize> {
     grab_pull: [Vec3; MAX_GRABS],
     /// One iteration's `Δx` per node.
     step: [Vec3; N],
-    /// Longest move of a node in one iteration: the strand's rest length, m.
+    /// Longest move of a node in one iteration: ten times the strand's rest length, m.
     trust_radius: Real,
     /// `Σ_k ∇_{x_i}C_kᵀ δλ_k` over each collider's rows: the hair's push on it, × h².
     collider_push: [Vec3; MAX_COLLIDERS],
     truncated: bool,
 }
+
+/// The trust radius of one projection iteration, in strand rest lengths (see
+/// `solve_and_move`).
+const TRUST_RADIUS_IN_STRAND_LENGTHS: Real = 10.0;
 
 /// Compile-time check that row and node indices fit the `u16`s the rows store.
 struct IndexFits<const N: usize>;
@@ -94,8 +98,9 @@ impl<const N: usize> IndexFits<N> {
 ///
 /// Runs when any of the effects `inextensibility`, `collisions`, `grabs` is on, and builds
 /// only the rows of those that are. Callable on any strand, colliders and grabs (so that a
-/// fuzz target can drive it with a `StepContext::new` of its own): it never panics, and degenerate input (coincident nodes, a node at a
-/// sphere's centre, huge stretch) gives finite positions and an honest residual.
+/// fuzz target can drive it with a `StepContext::new` of its own): it never panics, and
+/// degenerate input (coincident nodes, a node at a sphere's centre, huge stretch) gives
+/// finite positions and an honest residual.
 pub fn project_constraints<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -165,12 +170,13 @@ impl<const N: usize> Workspace<N> {
             multipliers: [0.0; N],
             grab_pull: [Vec3::ZERO; MAX_GRABS],
             step: [Vec3::ZERO; N],
-            trust_radius: strand
-                .rest
-                .segment_length
-                .iter()
-                .take(n.saturating_sub(1))
-                .sum(),
+            trust_radius: TRUST_RADIUS_IN_STRAND_LENGTHS
+                * strand
+                    .rest
+                    .segment_length
+                    .iter()
+                    .take(n.saturating_sub(1))
+                    .sum::<Real>(),
             collider_push: [Vec3::ZERO; MAX_COLLIDERS],
             truncated: false,
         }
@@ -300,9 +306,12 @@ fn solve_and_move<M: Math, const N: usize>(
         }
     }
     // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
-    // asks for a move of ê²/(2|e|), unbounded. No projection of a sane state moves a node
-    // further than the strand is long in one iteration, so a longer step is scaled down
-    // whole (its direction kept) — garbage converges slowly instead of exploding.
+    // asks for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled
+    // down whole (its direction kept): garbage then converges slowly instead of exploding.
+    // Legitimate iterates do overshoot — on a chain pulled taut between the root and a grab
+    // the Newton step is nearly singular across the chain; the firmware scene measured 1.5×
+    // the strand's length — and cutting those short breaks the iteration, hence a radius of
+    // ten strand lengths.
     let mut longest2: Real = 0.0;
     for dx in step.iter().take(n) {
         let d2 = dx.dot(*dx);
