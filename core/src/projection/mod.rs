@@ -308,10 +308,10 @@ fn solve_and_move<M: Math, const N: usize>(
     // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
     // asks for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled
     // down whole (its direction kept): garbage then converges slowly instead of exploding.
-    // Legitimate iterates do overshoot — on a chain pulled taut between the root and a grab
-    // the Newton step is nearly singular across the chain; the firmware scene measured 1.5×
-    // the strand's length — and cutting those short breaks the iteration, hence a radius of
-    // ten strand lengths.
+    // Legitimate iterates do overshoot: in a violent step (the firmware scene's strand 1 at
+    // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
+    // the next ones converged; a radius of one strand length cut that short and broke the
+    // iteration. Hence ten strand lengths.
     let mut longest2: Real = 0.0;
     for dx in step.iter().take(n) {
         let d2 = dx.dot(*dx);
