@@ -170,6 +170,10 @@ fn a_grab_holding_a_hanging_strand_feels_the_weight_it_holds() {
         report = world.step(&still());
     }
     let force = report.grab_forces[0];
+    println!(
+        "grab force {force} N, weight held {weight} N, relative error {:.2e}",
+        (force.y + weight).abs() / weight
+    );
     // Downward (the device feels the hair pull), equal to the weight within 1 %.
     assert!(
         (force.y + weight).abs() <= 0.01 * weight,
