@@ -348,8 +348,16 @@ fn pass<
         let start = Chain::start::<M>(&setup, root_frame, x0, x1);
         chain.set(l, &start);
     }
-    let mut tally = [Tally::default(); W];
-    let mut previous_contact = [false; W];
+    // Per-lane report values and flags as `Real` lanes and selects (no branch in a lane loop,
+    // so the compiler vectorises it). Contact flags are 0 or 1.
+    let nodes_real: Lanes<W> = core::array::from_fn(|l| nodes[l] as Real);
+    let mut stretch: Lanes<W> = [0.0; W];
+    let mut contact_stretch: Lanes<W> = [0.0; W];
+    let mut penetration: Lanes<W> = [0.0; W];
+    let mut contacts: Lanes<W> = [0.0; W];
+    // 0 while every value a lane wrote is finite (x − x is NaN for ±∞ and NaN).
+    let mut poison: Lanes<W> = [0.0; W];
+    let mut previous_contact: Lanes<W> = [0.0; W];
     for k in 2..max_nodes {
         let (done, todo) = block.state.split_at_mut(k);
         let (Some(previous), Some(state), Some(rest), Some(shape)) = (
@@ -360,6 +368,7 @@ fn pass<
         ) else {
             break;
         };
+        let node = k as Real;
         // Lines 13–19: predict, shape, follow the leader.
         let mut x = [[0.0; W]; 3];
         let mut correction = [[0.0; W]; 3];
@@ -387,76 +396,99 @@ fn pass<
         }
         // Line 20: collisions, one collider over all lanes at a time (the same order of
         // colliders as the per-strand path, so the same bits).
-        let mut contact = [false; W];
+        let mut contact = [0.0; W];
         if setup.collisions {
             for collider in ctx.colliders() {
                 push_out_lanes::<M, W>(collider, &mut x, &mut contact);
             }
             for collider in ctx.colliders() {
-                for (l, t) in tally.iter_mut().enumerate() {
+                for l in 0..W {
                     let depth = collisions::depth::<M>(collider, get(&x, l));
-                    if k < nodes[l] {
-                        t.penetration = t.penetration.max(depth);
-                    }
+                    let depth = if node < nodes_real[l] { depth } else { 0.0 };
+                    penetration[l] = penetration[l].max(depth);
                 }
             }
-            for (l, t) in tally.iter_mut().enumerate() {
-                t.contacts += u32::from(contact[l] && k < nodes[l]);
+            for l in 0..W {
+                contacts[l] += if node < nodes_real[l] {
+                    contact[l]
+                } else {
+                    0.0
+                };
             }
         }
         // Line 21 and lines 24–26 for node k − 1.
+        let after_first = k > 2;
         for l in 0..W {
-            let active = k < nodes[l];
+            let active = node < nodes_real[l];
+            // Node k − 1 exists in this lane (and is free): finish it now.
+            let finishing = after_first && node - 1.0 < nodes_real[l];
             let here = chain.get(l);
-            let (next, stretch) = here.advance::<M>(&setup, get(&x, l), rest.segment_length[l]);
-            let t = &mut tally[l];
-            if active {
-                if contact[l] || previous_contact[l] {
-                    t.contact_stretch = t.contact_stretch.max(stretch);
-                } else {
-                    t.stretch = t.stretch.max(stretch);
-                }
-            }
-            if k > 2 && k - 1 < nodes[l] {
-                // The last node of a lane (k == nodes[l]) gets no correction.
-                let next_correction = if active {
-                    get(&correction, l)
-                } else {
-                    Vec3::ZERO
-                };
-                let (x_new, v_new) = velocity::finish(
-                    &setup,
-                    here.position,
-                    get(&previous.position, l),
-                    next_correction,
-                );
-                set(&mut previous.position, l, x_new);
-                set(&mut previous.velocity, l, v_new);
-                finite[l] &= crate::math::is_finite(x_new) && crate::math::is_finite(v_new);
-            }
-            if active {
-                chain.set(l, &next);
-                previous_contact[l] = contact[l];
-            }
+            let (next, s) = here.advance::<M>(&setup, get(&x, l), rest.segment_length[l]);
+            let touched = contact[l] + previous_contact[l] > 0.0;
+            stretch[l] = stretch[l].max(if active && !touched { s } else { 0.0 });
+            contact_stretch[l] = contact_stretch[l].max(if active && touched { s } else { 0.0 });
+            // The last node of a lane (k == nodes[l]) gets no correction.
+            let next_correction = if active {
+                get(&correction, l)
+            } else {
+                Vec3::ZERO
+            };
+            let old_position = get(&previous.position, l);
+            let old_velocity = get(&previous.velocity, l);
+            let (x_new, v_new) =
+                velocity::finish(&setup, here.position, old_position, next_correction);
+            let (x_new, v_new) = if finishing {
+                (x_new, v_new)
+            } else {
+                (old_position, old_velocity)
+            };
+            set(&mut previous.position, l, x_new);
+            set(&mut previous.velocity, l, v_new);
+            poison[l] += not_finite(x_new) + not_finite(v_new);
+            let kept = if active { next } else { here };
+            chain.set(l, &kept);
+            previous_contact[l] = if active {
+                contact[l]
+            } else {
+                previous_contact[l]
+            };
         }
     }
     // The last node of the longest lanes: no correction.
     if let Some(last) = block.state.get_mut(max_nodes - 1) {
+        let longest = max_nodes as Real;
         for l in 0..W {
-            if nodes[l] == max_nodes {
-                let here = chain.get(l);
-                let (x_new, v_new) =
-                    velocity::finish(&setup, here.position, get(&last.position, l), Vec3::ZERO);
-                set(&mut last.position, l, x_new);
-                set(&mut last.velocity, l, v_new);
-                finite[l] &= crate::math::is_finite(x_new) && crate::math::is_finite(v_new);
-            }
+            let here = chain.get(l);
+            let old_position = get(&last.position, l);
+            let old_velocity = get(&last.velocity, l);
+            let (x_new, v_new) = velocity::finish(&setup, here.position, old_position, Vec3::ZERO);
+            let (x_new, v_new) = if nodes_real[l] == longest {
+                (x_new, v_new)
+            } else {
+                (old_position, old_velocity)
+            };
+            set(&mut last.position, l, x_new);
+            set(&mut last.velocity, l, v_new);
+            poison[l] += not_finite(x_new) + not_finite(v_new);
         }
     }
-    for t in tally.iter().take(block.strands) {
-        t.report(report);
+    for l in 0..block.strands.min(W) {
+        Tally {
+            stretch: stretch[l],
+            contact_stretch: contact_stretch[l],
+            penetration: penetration[l],
+            contacts: contacts[l] as u32,
+        }
+        .report(report);
+        finite[l] &= poison[l] == 0.0;
     }
     finite
+}
+
+/// 0 when every component of `v` is finite, NaN otherwise (`x − x`), summed per lane.
+#[inline(always)]
+fn not_finite(v: Vec3) -> Real {
+    (v.x - v.x) + (v.y - v.y) + (v.z - v.z)
 }
 
 /// Lines 13–19 over the lanes of one node.
@@ -494,11 +526,11 @@ fn project_lanes<M: Math, const W: usize>(
 fn push_out_lanes<M: Math, const W: usize>(
     collider: &Shape,
     x: &mut VecLanes<W>,
-    contact: &mut [bool; W],
+    contact: &mut Lanes<W>,
 ) {
     for l in 0..W {
         let (pushed, inside) = collisions::push_out::<M>(collider, get(x, l));
         set(x, l, pushed);
-        contact[l] |= inside;
+        contact[l] = if inside { 1.0 } else { contact[l] };
     }
 }
