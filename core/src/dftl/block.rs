@@ -487,6 +487,7 @@ fn pass<
 
 /// 0 when every component of `v` is finite, NaN otherwise (`x − x`), summed per lane.
 #[inline(always)]
+#[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
 fn not_finite(v: Vec3) -> Real {
     (v.x - v.x) + (v.y - v.y) + (v.z - v.z)
 }
