@@ -391,7 +391,10 @@ mod tests {
         let v = Vec3::new(0.3, -1.2, 2.0);
         let r: Vec3 = Q::<Real>::from(q).rotate(v.into()).into();
         assert_eq!(r, math::rotate(q, v));
-        let p: Quat = Q::<Real>::from(q).product(q.into()).normalize::<Libm>().into();
+        let p: Quat = Q::<Real>::from(q)
+            .product(q.into())
+            .normalize::<Libm>()
+            .into();
         assert_eq!(p, math::quat_normalize::<Libm>(math::quat_mul(q, q)));
         let wide = Q::<Wide<4>>::splat(q).rotate(V3::splat(v));
         assert_eq!(wide.y.0, [r.y; 4]);
