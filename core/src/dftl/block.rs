@@ -432,7 +432,15 @@ fn pass<
         store(&mut previous.position, x_new);
         store(&mut previous.velocity, v_new);
         poison = poison + not_finite(x_new) + not_finite(v_new);
-        chain = Chain::select(active, &next, &chain);
+        chain = if SHAPE {
+            Chain::select(active, &next, &chain)
+        } else {
+            // Without shape the frames never change: carry the position only.
+            Chain {
+                position: V3::select(active, next.position, chain.position),
+                ..chain
+            }
+        };
         previous_contact = (active & contact) | (!active & previous_contact);
     }
     // The last node of the longest lanes: no correction.
