@@ -1,14 +1,22 @@
 //! # hairsim (the std harness)
 //!
-//! Everything around the `no_std` core that a desktop user touches: built-in scenes, runs with
-//! a summary (text or JSON), and — as the issues land — scene files, SPH hair–hair interaction,
-//! record and replay, hair files in and out, pictures and studies.
+//! Everything around the `no_std` core that a desktop user touches: scene files
+//! ([`scene`]), built-in scenes ([`builtin`]), runs on threads with a summary ([`run`],
+//! [`sim`], [`summary`]), record and replay ([`record`]), the command line ([`cmd`]), SPH
+//! hair–hair interaction ([`sph`]), hair files in ([`hairfile`]) and out ([`export`]), and
+//! pictures ([`picture`]).
 
 pub mod builtin;
+pub mod cmd;
 pub mod export;
 pub mod hairfile;
+pub mod hairscene;
+pub mod output;
 pub mod picture;
+pub mod record;
 pub mod run;
+pub mod scene;
+pub mod sim;
 pub mod sph;
 pub mod summary;
 

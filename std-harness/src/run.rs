@@ -1,18 +1,114 @@
-//! Running a scene: step it, time every step, and summarise.
+//! Running a scene: pick the strand capacity, step it (on threads), time every step,
+//! record or replay the inputs, and summarise.
 
-use std::time::Instant;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
-use anyhow::{bail, Result};
-use hairsim_core::scenes::firmware;
-use hairsim_core::{DefaultMath, Math, StepReport, World};
+use anyhow::{anyhow, bail, Result};
+use hairsim_core::grab::GrabStatus;
+use hairsim_core::{DefaultMath, Math, StepReport};
 
+use crate::builtin;
+use crate::output;
+use crate::record::{BuildIdentity, Checkpoint, RecordedInputs, Recording, CAPACITIES, VERSION};
+use crate::scene::{Prepared, Scene, SceneError};
+use crate::sim::{scene_inputs, Sim, StepInputs};
 use crate::summary::{hash_string, Summary};
 
-/// Options of `hairsim run` that do not depend on the scene.
+/// A scene ready to run, and where it came from.
+#[derive(Clone, Debug)]
+pub struct Loaded {
+    /// `builtin:NAME` or the file path.
+    pub source: String,
+    /// The scene as written.
+    pub scene: Scene,
+    /// The checked plan.
+    pub prepared: Prepared,
+}
+
+/// Options for a hair file given as the scene (`hairsim run head.hair`).
 #[derive(Clone, Debug, Default)]
+pub struct HairFileOptions {
+    /// Factor from the file's units to metres.
+    pub scale: Option<f32>,
+    /// The file's up axis, `y` or `z`.
+    pub up: Option<String>,
+}
+
+/// Loads SCENE: a built-in name, a TOML scene file, or a `.hair`/`.tfx` hair file.
+pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
+    if let Some(b) = builtin::find(spec) {
+        let scene = (b.scene)();
+        let prepared = scene.prepare().map_err(|e| anyhow!(e.in_builtin(b.name)))?;
+        return Ok(Loaded {
+            source: format!("builtin:{}", b.name),
+            scene,
+            prepared,
+        });
+    }
+    let path = Path::new(spec);
+    let lower = spec.to_ascii_lowercase();
+    if lower.ends_with(".hair") || lower.ends_with(".tfx") {
+        let scene_error = |e: crate::scene::FieldError| {
+            anyhow!(SceneError {
+                file: format!("{spec} (default scene)"),
+                line: 0,
+                field: e.field,
+                message: e.message,
+            })
+        };
+        let scene = crate::hairscene::scene_for_hair_file(path, hair).map_err(scene_error)?;
+        let prepared = scene.prepare().map_err(scene_error)?;
+        return Ok(Loaded {
+            source: spec.to_string(),
+            scene,
+            prepared,
+        });
+    }
+    if !path.exists() {
+        let names: Vec<&str> = builtin::BUILTINS.iter().map(|b| b.name).collect();
+        bail!(
+            "{spec}: no such scene: not a built-in scene ({}) nor an existing file",
+            names.join(", ")
+        );
+    }
+    let (scene, prepared) = Scene::load(path)?;
+    Ok(Loaded {
+        source: spec.to_string(),
+        scene,
+        prepared,
+    })
+}
+
+/// Options of `hairsim run` that do not depend on the scene.
+#[derive(Clone, Debug)]
 pub struct RunOptions {
     /// Overrides the scene's step count.
     pub steps: Option<u64>,
+    /// Threads stepping strand blocks (the result never depends on it).
+    pub threads: usize,
+    /// Frames (with `out`) and checkpoints (with `record`) every this many steps.
+    pub every: Option<u64>,
+    /// Folder for frames and pictures.
+    pub out: Option<PathBuf>,
+    /// File to record the run to.
+    pub record: Option<PathBuf>,
+    /// Show a progress bar (only on a terminal, only past one second).
+    pub progress: bool,
+}
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunOptions {
+            steps: None,
+            threads: 1,
+            every: None,
+            out: None,
+            record: None,
+            progress: false,
+        }
+    }
 }
 
 /// Accumulates step reports over a run.
@@ -41,7 +137,7 @@ impl Totals {
     }
 }
 
-/// Median of `times` in milliseconds (0 for none).
+/// Median of `times` (seconds) in milliseconds (0 for none).
 #[must_use]
 pub fn median_ms(times: &mut [f64]) -> f64 {
     if times.is_empty() {
@@ -51,44 +147,284 @@ pub fn median_ms(times: &mut [f64]) -> f64 {
     times[times.len() / 2] * 1e3
 }
 
-/// Runs the built-in scene `name`.
+/// The smallest capacity of this build that holds `nodes` nodes.
+pub fn capacity_for(nodes: usize) -> Result<usize> {
+    CAPACITIES
+        .iter()
+        .copied()
+        .find(|&c| nodes <= c)
+        .ok_or_else(|| {
+            anyhow!(
+                "a strand has {nodes} nodes, allowed at most {} in this build",
+                CAPACITIES[3]
+            )
+        })
+}
+
+/// Where a run's inputs come from.
+enum Inputs<'a> {
+    /// Computed from the scene.
+    Scene,
+    /// Read from a recording; the run checks its hashes.
+    Replay(&'a Recording),
+}
+
+/// Runs a loaded scene.
+pub fn run(loaded: &Loaded, options: &RunOptions) -> Result<Summary> {
+    if options.threads == 0 || options.threads > 1024 {
+        bail!(
+            "--threads: {} is out of range, allowed 1 to 1024",
+            options.threads
+        );
+    }
+    if let Some(every) = options.every {
+        if every == 0 {
+            bail!("--every: 0 is out of range, allowed 1 or more steps");
+        }
+    }
+    if let Some(steps) = options.steps {
+        if steps == 0 {
+            bail!("--steps: 0 is out of range, allowed 1 or more");
+        }
+    }
+    dispatch(loaded, options, &Inputs::Scene)
+}
+
+/// Runs the built-in scene `name` (what `hairsim run NAME` runs).
 pub fn run_builtin(name: &str, options: &RunOptions) -> Result<Summary> {
-    match name {
-        "firmware" => run_firmware::<DefaultMath>(options),
-        other => bail!(
-            "unknown scene \"{other}\": not a built-in scene (see `hairsim scenes`) nor an existing file"
-        ),
+    if builtin::find(name).is_none() {
+        bail!("{name}: not a built-in scene (see `hairsim scenes`)");
+    }
+    run(&load(name, &HairFileOptions::default())?, options)
+}
+
+/// Replays a recording: the scene it holds, driven by its inputs, checked against its hashes.
+/// Fails at the first checkpoint whose hash differs.
+pub fn replay(path: &Path, threads: usize) -> Result<Summary> {
+    let recording = Recording::read(path, &BuildIdentity::current::<DefaultMath>())?;
+    let label = format!("{}#scene", path.display());
+    let base = path.parent().unwrap_or(Path::new("."));
+    let (scene, prepared) = Scene::parse_and_prepare(&recording.scene, &label, base)?;
+    let loaded = Loaded {
+        source: recording.source.clone(),
+        scene,
+        prepared,
+    };
+    let options = RunOptions {
+        steps: Some(recording.inputs.len() as u64),
+        threads,
+        ..RunOptions::default()
+    };
+    if recording.inputs.is_empty() {
+        bail!(
+            "{}: the recording is damaged: it holds no steps",
+            path.display()
+        );
+    }
+    let capacity = capacity_for(loaded.prepared.max_nodes())?;
+    if capacity != recording.capacity {
+        bail!(
+            "{}: recorded with capacity {}, the scene now needs {capacity}",
+            path.display(),
+            recording.capacity
+        );
+    }
+    dispatch(&loaded, &options, &Inputs::Replay(&recording))
+        .map_err(|e| anyhow!("{}: {e:#}", path.display()))
+}
+
+fn dispatch(loaded: &Loaded, options: &RunOptions, inputs: &Inputs<'_>) -> Result<Summary> {
+    match capacity_for(loaded.prepared.max_nodes())? {
+        16 => run_n::<16, DefaultMath>(loaded, options, inputs),
+        32 => run_n::<32, DefaultMath>(loaded, options, inputs),
+        64 => run_n::<64, DefaultMath>(loaded, options, inputs),
+        _ => run_n::<128, DefaultMath>(loaded, options, inputs),
     }
 }
 
-/// The firmware example's scene, stepped exactly as `firmware/` steps it under QEMU.
-fn run_firmware<M: Math>(options: &RunOptions) -> Result<Summary> {
-    let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, M>> = Box::default();
-    firmware::build(&mut world).map_err(|e| anyhow::anyhow!("building the firmware scene: {e}"))?;
-    let steps = options.steps.unwrap_or(u64::from(firmware::STEPS));
+/// A progress bar that appears once a run has taken a second, on a terminal only.
+struct Progress {
+    enabled: bool,
+    start: Instant,
+    steps: u64,
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress {
+    fn new(enabled: bool, steps: u64) -> Progress {
+        Progress {
+            enabled: enabled && std::io::stderr().is_terminal(),
+            start: Instant::now(),
+            steps,
+            bar: None,
+        }
+    }
+
+    fn tick(&mut self, done: u64) {
+        if !self.enabled || done % 64 != 0 {
+            return;
+        }
+        if self.bar.is_none() && self.start.elapsed() > Duration::from_secs(1) {
+            let bar = indicatif::ProgressBar::new(self.steps);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} steps, {per_sec}, eta {eta}",
+            ) {
+                bar.set_style(style);
+            }
+            self.bar = Some(bar);
+        }
+        if let Some(bar) = &self.bar {
+            bar.set_position(done);
+        }
+    }
+
+    fn finish(self) {
+        if let Some(bar) = self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+fn run_n<const N: usize, M: Math>(
+    loaded: &Loaded,
+    options: &RunOptions,
+    inputs: &Inputs<'_>,
+) -> Result<Summary> {
+    let prepared = &loaded.prepared;
+    let mut sim = Sim::<N, M>::new(prepared, options.threads).map_err(|e| anyhow!("{e}"))?;
+    let steps = options.steps.unwrap_or(prepared.steps);
+    let every = options.every;
+    let mut recording = options.record.as_ref().map(|_| Recording {
+        version: VERSION,
+        build: BuildIdentity::current::<M>(),
+        source: loaded.source.clone(),
+        scene: loaded.scene.to_toml(),
+        capacity: N,
+        every: every.unwrap_or(10),
+        inputs: Vec::with_capacity(steps as usize),
+        checkpoints: Vec::new(),
+    });
+    let mut frames = match &options.out {
+        Some(dir) => Some(output::Frames::new(dir, prepared, every, steps)?),
+        None => None,
+    };
     let mut totals = Totals::default();
     let mut times = Vec::with_capacity(steps as usize);
+    let mut last = StepReport::default();
+    let mut progress = Progress::new(options.progress, steps);
+    let mut replayed = match inputs {
+        Inputs::Replay(r) => Some((r, r.checkpoints.iter().peekable())),
+        Inputs::Scene => None,
+    };
     for k in 0..steps {
+        let step_inputs: StepInputs = match &replayed {
+            Some((r, _)) => r.inputs[k as usize].to_inputs(),
+            None => scene_inputs::<M>(prepared, k),
+        };
         let start = Instant::now();
-        let report = firmware::step(&mut world, k as u32);
+        last = sim.step(&step_inputs);
         times.push(start.elapsed().as_secs_f64());
-        totals.add(&report);
+        totals.add(&last);
+        let done = k + 1;
+        if let Some(r) = &mut recording {
+            r.inputs.push(RecordedInputs::from_inputs(&step_inputs));
+            if done % r.every == 0 || done == steps {
+                r.checkpoints.push(Checkpoint {
+                    step: done,
+                    hash: hash_string(sim.state_hash()),
+                });
+            }
+        }
+        if let Some((_, checkpoints)) = &mut replayed {
+            if let Some(c) = checkpoints.next_if(|c| c.step == done) {
+                let now = hash_string(sim.state_hash());
+                if now != c.hash {
+                    progress.finish();
+                    bail!(
+                        "replay differs at step {done}: recorded state hash {}, replayed {now}",
+                        c.hash
+                    );
+                }
+            }
+        }
+        if let Some(f) = &mut frames {
+            f.after_step(done, &sim.strands, &sim.head)?;
+        }
+        progress.tick(done);
     }
+    progress.finish();
+    if let Some((_, checkpoints)) = &mut replayed {
+        if let Some(c) = checkpoints.next() {
+            bail!(
+                "the recording is damaged: checkpoint at step {} is past its {steps} steps",
+                c.step
+            );
+        }
+    }
+    if let (Some(r), Some(path)) = (&recording, &options.record) {
+        r.write(path)?;
+    }
+    let written = match frames {
+        Some(f) => f.finish(&sim.strands, &sim.head)?,
+        None => Vec::new(),
+    };
+    let grabs = !sim.grabs.is_empty();
     Ok(Summary {
-        scene: "firmware".into(),
-        solver: world.params().solver.name().into(),
+        scene: prepared.name.clone(),
+        solver: prepared.params.solver.name().into(),
         math: M::NAME.into(),
+        effects: prepared
+            .params
+            .effects
+            .iter()
+            .map(|e| e.name().to_string())
+            .collect(),
         steps,
-        dt: world.params().dt,
-        strands: world.strands().len(),
-        nodes: world.strands().iter().map(|s| s.nodes()).sum(),
-        state_hash: hash_string(world.state_hash()),
+        dt: prepared.params.dt,
+        strands: sim.strands.len(),
+        nodes: prepared.nodes(),
+        followers: prepared.followers.len(),
+        capacity: N,
+        block: prepared.block,
+        threads: options.threads,
+        state_hash: hash_string(sim.state_hash()),
         max_stretch: totals.max_stretch,
         max_penetration: totals.max_penetration,
-        finite: world.strands().iter().all(|s| s.is_finite()),
+        finite: sim.is_finite(),
         ms_per_step: median_ms(&mut times),
         iterations: totals.iterations,
         caps_hit: totals.caps_hit,
         rolled_back: totals.rolled_back,
+        grab_forces: grabs.then(|| {
+            last.grab_forces[..sim.grabs.len()]
+                .iter()
+                .map(|f| f.to_array())
+                .collect()
+        }),
+        grab_status: grabs.then(|| {
+            sim.grabs
+                .iter()
+                .map(|g| {
+                    match g.status {
+                        GrabStatus::Held => "held",
+                        GrabStatus::Slipped => "slipped",
+                        GrabStatus::Released => "released",
+                    }
+                    .to_string()
+                })
+                .collect()
+        }),
+        sph_neighbours: sim.sph.as_ref().map(|sph| {
+            let samples = sph.stats.runs as f64 * sph.particles().max(1) as f64;
+            sph.stats.neighbours as f64 / samples.max(1.0)
+        }),
+        sph_truncated: sim.sph.as_ref().map(|sph| sph.stats.truncated),
+        written: written.iter().map(|p| p.display().to_string()).collect(),
+        collider_forces: (!sim.colliders.is_empty()).then(|| {
+            last.collider_forces[..sim.colliders.len()]
+                .iter()
+                .map(|f| f.to_array())
+                .collect()
+        }),
     })
 }

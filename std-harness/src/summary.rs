@@ -11,6 +11,8 @@ pub struct Summary {
     pub solver: String,
     /// Math backend name.
     pub math: String,
+    /// The effects that ran, by name.
+    pub effects: Vec<String>,
     /// Steps run.
     pub steps: u64,
     /// Time step, s.
@@ -19,6 +21,14 @@ pub struct Summary {
     pub strands: usize,
     /// Simulated nodes (all strands).
     pub nodes: usize,
+    /// Follower strands (drawn, not simulated).
+    pub followers: usize,
+    /// Node capacity the run was built with.
+    pub capacity: usize,
+    /// Strands per block.
+    pub block: usize,
+    /// Threads used.
+    pub threads: usize,
     /// State hash after the last step, as `0x` + 16 hex digits.
     pub state_hash: String,
     /// Largest relative stretch of a segment without contact, over the run.
@@ -35,6 +45,24 @@ pub struct Summary {
     pub caps_hit: u64,
     /// Strand roll-backs over the run.
     pub rolled_back: u64,
+    /// Each grab's force after the last step, N (only with grabs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grab_forces: Option<Vec<[f32; 3]>>,
+    /// Each grab's status after the last step: held, slipped or released (only with grabs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grab_status: Option<Vec<String>>,
+    /// SPH neighbours per node per step, on average (only with `hair-hair`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sph_neighbours: Option<f64>,
+    /// Neighbours the SPH cap dropped, over the run (only with `hair-hair`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sph_truncated: Option<u64>,
+    /// Files written by `--out` (empty without it).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub written: Vec<String>,
+    /// Each collider's total contact force after the last step, N (only with colliders).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collider_forces: Option<Vec<[f32; 3]>>,
 }
 
 /// Formats a state hash the way every tool prints it.
@@ -43,25 +71,38 @@ pub fn hash_string(hash: u64) -> String {
     format!("0x{hash:016x}")
 }
 
+fn vectors(v: &[[f32; 3]]) -> String {
+    v.iter()
+        .map(|f| format!("[{:.3e}, {:.3e}, {:.3e}]", f[0], f[1], f[2]))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
 impl Summary {
     /// The summary as one line of JSON.
     #[must_use]
     pub fn to_json(&self) -> String {
-        serde_json::to_string(self).expect("a summary always serialises")
+        // Plain fields only; f32 non-finite values become `null`, never an error.
+        serde_json::to_string(self).unwrap_or_else(|e| format!("{{\"error\":\"{e}\"}}"))
     }
 
     /// The summary for people.
     #[must_use]
     pub fn to_text(&self) -> String {
-        format!(
-            "scene       {}\nsolver      {} ({} math)\nsteps       {} x {} s\nstrands     {} ({} nodes)\nstate hash  {}\nmax stretch {:.3e}\nmax depth   {:.3e} m\nfinite      {}\nstep time   {:.4} ms (median)\niterations  {} (caps hit {}, rolled back {})",
+        let mut text = format!(
+            "scene       {}\nsolver      {} ({} math)\neffects     {}\nsteps       {} x {} s\nstrands     {} ({} nodes, capacity {}), {} followers\nthreads     {} (blocks of {} strands)\nstate hash  {}\nmax stretch {:.3e}\nmax depth   {:.3e} m\nfinite      {}\nstep time   {:.4} ms (median)\niterations  {} (caps hit {}, rolled back {})",
             self.scene,
             self.solver,
             self.math,
+            self.effects.join(", "),
             self.steps,
             self.dt,
             self.strands,
             self.nodes,
+            self.capacity,
+            self.followers,
+            self.threads,
+            self.block,
             self.state_hash,
             self.max_stretch,
             self.max_penetration,
@@ -70,6 +111,28 @@ impl Summary {
             self.iterations,
             self.caps_hit,
             self.rolled_back
-        )
+        );
+        if let (Some(forces), Some(status)) = (&self.grab_forces, &self.grab_status) {
+            text.push_str(&format!(
+                "\ngrabs       {} ({})",
+                vectors(forces),
+                status.join(", ")
+            ));
+        }
+        if let Some(forces) = &self.collider_forces {
+            text.push_str(&format!("\ncolliders   {}", vectors(forces)));
+        }
+        if let (Some(mean), Some(truncated)) = (self.sph_neighbours, self.sph_truncated) {
+            text.push_str(&format!(
+                "\nhair-hair   {mean:.1} neighbours per node, {truncated} dropped by the cap"
+            ));
+        }
+        if let Some(last) = self.written.last() {
+            text.push_str(&format!(
+                "\nwritten     {} files, last {last}",
+                self.written.len()
+            ));
+        }
+        text
     }
 }

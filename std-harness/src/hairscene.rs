@@ -1,0 +1,199 @@
+//! The default scene around a hair file (`hairsim run head.hair`): the rod solver at 1 ms,
+//! gravity, drag, bending, twist and inextensibility, the head still, and a head sphere fitted
+//! to the strands' roots (with collisions on) when the roots outline one.
+//!
+//! The file is read (by the `hairfile` module) once here to fit the head to its roots, and
+//! again when the scene is prepared, like any `[hair.file]`.
+
+use std::path::Path;
+
+use hairsim_core::Vec3;
+
+use crate::run::HairFileOptions;
+use crate::scene::{ColliderSpec, FieldError, FileSpec, HairSpec, Scene, FORMAT};
+
+/// Strands the default scene keeps at most, picked evenly through the file.
+pub const DEFAULT_MAX_STRANDS: u32 = 1000;
+/// Nodes every strand is resampled to in the default scene.
+pub const DEFAULT_NODES: u32 = 24;
+
+/// The default scene for the hair file at `path`.
+pub fn scene_for_hair_file(path: &Path, options: &HairFileOptions) -> Result<Scene, FieldError> {
+    // Checked like a scene's [hair.file] table, so --scale and --up get the same messages.
+    let bare = scene_around(path, options, &[]);
+    crate::scene::validate_only(&bare)?;
+    let Some(HairSpec::File(file)) = &bare.hair else {
+        return Ok(bare);
+    };
+    let model = crate::scene::prepare::read_hair_file(file, Path::new("."))?;
+    let roots: Vec<Vec3> = model
+        .strands
+        .iter()
+        .filter_map(|s| s.first().copied())
+        .collect();
+    Ok(scene_around(path, options, &roots))
+}
+
+/// The default scene for the hair file at `path` whose strand roots (after `--scale` and
+/// `--up`) are `roots`.
+#[must_use]
+pub fn scene_around(path: &Path, options: &HairFileOptions, roots: &[Vec3]) -> Scene {
+    let name: String = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .take(64)
+        .collect();
+    let mut effects: Vec<String> = ["gravity", "drag", "bending", "twist", "inextensibility"]
+        .iter()
+        .map(|e| (*e).to_string())
+        .collect();
+    let colliders: Vec<ColliderSpec> = fit_sphere(roots)
+        .map(|(centre, radius)| ColliderSpec {
+            shape: "sphere".into(),
+            attached: Some(true),
+            centre: Some(centre.to_array()),
+            // Just inside the roots, so the held root nodes never start in contact.
+            radius: Some(radius * 0.97),
+            a: None,
+            b: None,
+            point: None,
+            normal: None,
+        })
+        .into_iter()
+        .collect();
+    if !colliders.is_empty() {
+        effects.push("collisions".into());
+    }
+    Scene {
+        format: FORMAT,
+        name: if name.is_empty() { "hair".into() } else { name },
+        about: Some(format!("default scene around {}", path.display())),
+        solver: "rod".into(),
+        dt: 0.001,
+        steps: Some(1000),
+        duration: None,
+        effects,
+        mode: None,
+        gravity: None,
+        drag: Some(2.0e-7),
+        strands_per_block: None,
+        material: None,
+        rod: None,
+        dftl: None,
+        head: None,
+        colliders,
+        hair: Some(HairSpec::File(FileSpec {
+            path: path.display().to_string(),
+            scale: options.scale,
+            up: options.up.clone(),
+            nodes: Some(DEFAULT_NODES),
+            max_strands: Some(DEFAULT_MAX_STRANDS),
+            min_length: None,
+        })),
+        strands: Vec::new(),
+        grabs: Vec::new(),
+        wind: None,
+        hair_hair: None,
+        output: None,
+    }
+}
+
+/// The sphere through `points` in the least-squares sense (algebraic fit:
+/// `|p|² = 2 c·p + (r² − |c|²)`, solved by Gaussian elimination in `f64`), or `None` when the
+/// points do not outline a sphere (fewer than 4, nearly coplanar, or a radius past 10 m).
+#[must_use]
+pub fn fit_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {
+    if points.len() < 4 {
+        return None;
+    }
+    // Normal equations A^T A x = A^T b with rows (2x, 2y, 2z, 1) and b = |p|².
+    let mut m = [[0.0f64; 5]; 4];
+    for p in points {
+        let (x, y, z) = (f64::from(p.x), f64::from(p.y), f64::from(p.z));
+        let row = [2.0 * x, 2.0 * y, 2.0 * z, 1.0];
+        let b = x * x + y * y + z * z;
+        for i in 0..4 {
+            for j in 0..4 {
+                m[i][j] += row[i] * row[j];
+            }
+            m[i][4] += row[i] * b;
+        }
+    }
+    let scale = m
+        .iter()
+        .map(|r| r[0].abs().max(r[3].abs()))
+        .fold(0.0, f64::max);
+    for col in 0..4 {
+        let pivot = (col..4).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
+        if m[pivot][col].abs() <= 1e-12 * scale.max(1e-300) {
+            return None;
+        }
+        m.swap(col, pivot);
+        let pivot_row = m[col];
+        for (row, r) in m.iter_mut().enumerate() {
+            if row != col {
+                let f = r[col] / pivot_row[col];
+                for (a, b) in r.iter_mut().zip(pivot_row).skip(col) {
+                    *a -= f * b;
+                }
+            }
+        }
+    }
+    let c = [m[0][4] / m[0][0], m[1][4] / m[1][1], m[2][4] / m[2][2]];
+    let k = m[3][4] / m[3][3];
+    let r2 = k + c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+    let r = libm::sqrt(r2);
+    (r2 > 0.0 && r <= 10.0 && c.iter().all(|v| v.is_finite()))
+        .then(|| (Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32), r as f32))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::generate::scalp_roots;
+
+    #[test]
+    fn fits_the_sphere_of_a_scalp() {
+        let centre = Vec3::new(0.01, 1.6, -0.02);
+        let roots: Vec<Vec3> = scalp_roots(200, centre, 0.09, 1.0)
+            .into_iter()
+            .map(|(p, _)| p)
+            .collect();
+        let (c, r) = fit_sphere(&roots).unwrap();
+        assert!((c - centre).length() < 1e-4, "{c}");
+        assert!((r - 0.09).abs() < 1e-4, "{r}");
+    }
+
+    #[test]
+    fn refuses_points_that_outline_no_sphere() {
+        assert_eq!(fit_sphere(&[Vec3::ZERO, Vec3::X, Vec3::Y]), None);
+        let plane: Vec<Vec3> = (0..20)
+            .map(|i| Vec3::new((i % 5) as f32, 0.0, (i / 5) as f32))
+            .collect();
+        assert_eq!(fit_sphere(&plane), None);
+    }
+
+    #[test]
+    fn the_default_scene_turns_collisions_on_only_with_a_fitted_head() {
+        let path = Path::new("wig.hair");
+        let bare = scene_around(path, &HairFileOptions::default(), &[]);
+        assert!(bare.colliders.is_empty() && !bare.effects.contains(&"collisions".into()));
+        let roots: Vec<Vec3> = scalp_roots(50, Vec3::ZERO, 0.1, 1.2)
+            .into_iter()
+            .map(|(p, _)| p)
+            .collect();
+        let fitted = scene_around(path, &HairFileOptions::default(), &roots);
+        assert_eq!(fitted.colliders.len(), 1);
+        assert!(fitted.effects.contains(&"collisions".into()));
+        assert_eq!(fitted.name, "wig");
+    }
+}

@@ -1,0 +1,239 @@
+//! A running simulation: the harness owns a `Vec<Strand<N>>` and steps it in blocks of a
+//! fixed size (the scene's `strands_per_block`) with [`hairsim_core::step_strands`], on as many
+//! threads as asked. Each block gets its own [`StepReport`] and the reports are merged in
+//! block order, so every bit of the state and of the report is the same whatever the thread
+//! count.
+
+use hairsim_core::context::StepContext;
+use hairsim_core::grab::GrabStatus;
+use hairsim_core::params::DftlCoefficients;
+use hairsim_core::{
+    step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, StepReport, Strand, Vec3,
+};
+use rayon::prelude::*;
+
+use crate::scene::{FieldError, Prepared};
+use crate::sph::Sph;
+
+/// The time-varying inputs of one step (what a recording stores).
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepInputs {
+    /// The head's pose at the end of the step.
+    pub head: Pose,
+    /// Each grab's target.
+    pub grab_targets: Vec<Vec3>,
+    /// Each grab: whether it has been let go.
+    pub released: Vec<bool>,
+}
+
+/// Time at the end of step `k` (0-based): `(k + 1) · dt`, computed in `f32` exactly as the
+/// firmware computes it.
+#[must_use]
+pub fn time_after(k: u64, dt: Real) -> Real {
+    (k + 1) as Real * dt
+}
+
+/// The scene's inputs for step `k`.
+#[must_use]
+pub fn scene_inputs<M: Math>(prepared: &Prepared, k: u64) -> StepInputs {
+    let t = time_after(k, prepared.params.dt);
+    StepInputs {
+        head: prepared.motion.pose_at::<M>(t),
+        grab_targets: prepared
+            .grabs
+            .iter()
+            .map(|g| g.path.target_at::<M>(t))
+            .collect(),
+        released: prepared
+            .grabs
+            .iter()
+            .map(|g| g.path.released_at(t))
+            .collect(),
+    }
+}
+
+/// A simulation of strands with capacity `N`, math backend `M`.
+pub struct Sim<const N: usize, M: Math> {
+    /// Parameters.
+    pub params: Params,
+    /// The strands.
+    pub strands: Vec<Strand<N>>,
+    /// Colliders.
+    pub colliders: Vec<Collider>,
+    /// Grabs.
+    pub grabs: Vec<Grab>,
+    /// The head's current pose.
+    pub head: Pose,
+    /// Steps taken.
+    pub steps: u64,
+    /// The SPH stage, when `hair-hair` is on.
+    pub sph: Option<Sph>,
+    block: usize,
+    dftl: DftlCoefficients,
+    accelerations: Vec<Vec3>,
+    pool: Option<rayon::ThreadPool>,
+    math: std::marker::PhantomData<M>,
+}
+
+impl<const N: usize, M: Math> Sim<N, M> {
+    /// Builds the strands of `prepared` at capacity `N`, to be stepped on `threads` threads.
+    pub fn new(prepared: &Prepared, threads: usize) -> Result<Self, FieldError> {
+        let head = prepared.motion.pose_at::<M>(0.0);
+        let mut strands = Vec::with_capacity(prepared.strands.len());
+        for (i, spec) in prepared.strands.iter().enumerate() {
+            let mut strand = Strand::<N>::from_polyline(&spec.points, &spec.material)
+                .map_err(|e| FieldError::new(spec.field.clone(), format!("strand {i}: {e}")))?;
+            fade_bending(&mut strand, spec.tip_stiffness);
+            if head != Pose::IDENTITY {
+                place(&mut strand, &head);
+            }
+            strands.push(strand);
+        }
+        let grabs = prepared
+            .grabs
+            .iter()
+            .map(|g| Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit))
+            .collect();
+        let pool = if threads > 1 {
+            Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .map_err(|e| {
+                        FieldError::new("--threads", format!("cannot start threads: {e}"))
+                    })?,
+            )
+        } else {
+            None
+        };
+        let sph = match &prepared.sph {
+            Some(params) => {
+                Some(Sph::new(*params, &strands).map_err(|e| FieldError::new("hair-hair", e))?)
+            }
+            None => None,
+        };
+        Ok(Sim {
+            params: prepared.params,
+            accelerations: if sph.is_some() {
+                vec![Vec3::ZERO; strands.len() * N]
+            } else {
+                Vec::new()
+            },
+            strands,
+            colliders: prepared.colliders.clone(),
+            grabs,
+            head,
+            steps: 0,
+            sph,
+            block: prepared.block.max(1),
+            // Computed once, as `World::configure` does (two `powf`, never per step).
+            dftl: prepared.params.dftl.at_step(prepared.params.dt),
+            pool,
+            math: std::marker::PhantomData,
+        })
+    }
+
+    /// The state hash of every strand (the core's order).
+    #[must_use]
+    pub fn state_hash(&self) -> u64 {
+        hairsim_core::hash::state_hash(&self.strands)
+    }
+
+    /// Whether every strand's state is finite.
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        self.strands.iter().all(Strand::is_finite)
+    }
+
+    /// Advances by one step with `inputs`.
+    pub fn step(&mut self, inputs: &StepInputs) -> StepReport {
+        let mut report = StepReport::default();
+        for (g, grab) in self.grabs.iter_mut().enumerate() {
+            if inputs.released.get(g).copied().unwrap_or(false) {
+                grab.status = GrabStatus::Released;
+            }
+            match inputs.grab_targets.get(g) {
+                Some(t) if hairsim_core::math::is_finite(*t) => grab.target = *t,
+                Some(_) => report.flags.insert(Flags::BAD_INPUT),
+                None => {}
+            }
+        }
+        let head = if inputs.head.is_finite() {
+            inputs.head
+        } else {
+            report.flags.insert(Flags::BAD_INPUT);
+            self.head
+        };
+        let t = time_after(self.steps, self.params.dt);
+        // As `World::step`: coefficients from set-up, the wind at the step's end time.
+        let ctx = StepContext::with_coefficients(
+            &self.params,
+            self.dftl,
+            self.head,
+            head,
+            &self.colliders,
+        )
+        .at_time(t);
+        let accelerations = match &mut self.sph {
+            Some(sph) if ctx.has(hairsim_core::Effect::HairHair) => {
+                let (strands, out, dt) = (&self.strands, &mut self.accelerations, ctx.dt);
+                match &self.pool {
+                    Some(pool) => pool.install(|| sph.accelerations(strands, dt, out)),
+                    None => sph.accelerations(strands, dt, out),
+                }
+                Some(self.accelerations.as_slice())
+            }
+            _ => None,
+        };
+        let block = self.block;
+        let grabs = self.grabs.as_slice();
+        let blocks: Vec<(usize, &mut [Strand<N>])> =
+            self.strands.chunks_mut(block).enumerate().collect();
+        let step_block = |(b, strands): (usize, &mut [Strand<N>])| {
+            let mut r = StepReport::default();
+            let acc =
+                accelerations.and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
+            step_strands::<M, N>(&ctx, strands, (b * block) as u32, grabs, acc, &mut r);
+            r
+        };
+        let reports: Vec<StepReport> = match &self.pool {
+            Some(pool) if blocks.len() > 1 => {
+                pool.install(|| blocks.into_par_iter().map(step_block).collect())
+            }
+            _ => blocks.into_iter().map(step_block).collect(),
+        };
+        // Block order, never completion order: the same sums whatever the thread count.
+        for r in &reports {
+            report.merge(r);
+        }
+        for (g, grab) in self.grabs.iter_mut().enumerate() {
+            if report.grabs_slipped & (1 << g) != 0 {
+                grab.status = GrabStatus::Slipped;
+            }
+        }
+        self.head = head;
+        self.steps += 1;
+        report
+    }
+}
+
+/// Bending stiffness fading linearly from the root's to `tip` times it at the last segment.
+fn fade_bending<const N: usize>(strand: &mut Strand<N>, tip: Real) {
+    if tip == 1.0 {
+        return;
+    }
+    let segments = strand.nodes() - 1;
+    for j in 0..segments {
+        let s = j as Real / (segments.max(2) - 1) as Real;
+        strand.rest.bending_stiffness[j] *= 1.0 - s + s * tip;
+    }
+}
+
+/// Moves a strand built in the head's frame to the head's starting pose.
+fn place<const N: usize>(strand: &mut Strand<N>, head: &Pose) {
+    let n = strand.nodes();
+    for p in &mut strand.state.position[..n] {
+        *p = head.transform_point(*p);
+    }
+    strand.state.root_frame = head.transform_vector(strand.state.root_frame);
+}
