@@ -27,8 +27,10 @@ use crate::strand::Strand;
 use super::lane::{Lane, Wide, WideMask, Q, V3};
 use super::{collisions, project_node, velocity, Chain, NodeInput, Setup, Tally};
 
-/// Lanes per block the harness should use on x86-64 (SSE2 baseline): measured fastest — 16
-/// lanes ran ≈ 2.5× faster than 8 (which spill registers on every node) and than 32.
+/// Lanes per block the harness should use on x86-64: measured fastest — on the SSE2 baseline
+/// 16 lanes ran ≈ 2.5× faster than 8 and than 32 (both spill far more), and with
+/// `-C target-cpu=x86-64-v3` (AVX2; the same bits: Rust never fuses a multiply-add) 16 lanes
+/// ran ≈ 1.3× faster again.
 pub const RECOMMENDED_LANES: usize = 16;
 
 /// `W` values, one per strand of a block.
