@@ -170,6 +170,10 @@ fn a_grab_holding_a_hanging_strand_feels_the_weight_it_holds() {
         report = world.step(&still());
     }
     let force = report.grab_forces[0];
+    println!(
+        "grab force {force} N, weight held {weight} N, relative error {:.2e}",
+        (force.y + weight).abs() / weight
+    );
     // Downward (the device feels the hair pull), equal to the weight within 1 %.
     assert!(
         (force.y + weight).abs() <= 0.01 * weight,
@@ -182,6 +186,13 @@ fn a_grab_holding_a_hanging_strand_feels_the_weight_it_holds() {
     // the check above could not pass.
     let own = world.strands()[0].rest.mass[2] * 9.81;
     assert!(own > 0.02 * weight);
+    // A held node follows its target exactly, with the velocity of the move.
+    let target = world.grabs()[0].target + Vec3::new(0.001, 0.0, 0.0);
+    world.set_grab_target(0, target);
+    world.step(&still());
+    let strand = &world.strands()[0];
+    assert_eq!(strand.positions()[2], target);
+    assert!((strand.state.velocity[2] - Vec3::new(1.0, 0.0, 0.0)).length() < 1e-3);
 }
 
 #[test]
@@ -237,4 +248,130 @@ fn fixed_cost_iterations_do_not_depend_on_the_state() {
         b += violent.step(&shaking(k * 7)).iterations_total;
     }
     assert!(a < b, "converge mode: calm {a}, violent {b} iterations");
+}
+
+/// A small deterministic generator (xorshift) for the garbage test.
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn below(&mut self, n: usize) -> usize {
+        ((self.next() * n as f32) as usize).min(n - 1)
+    }
+    fn point(&mut self, scale: f32) -> Vec3 {
+        Vec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5) * scale
+    }
+}
+
+/// What a fuzz target would do, on a budget: arbitrary strands, colliders (valid or not) and
+/// grabs (valid or not) straight into `project_constraints`. It never panics, keeps finite
+/// input finite, stays within the cap and reports a residual no smaller than the truth.
+#[test]
+fn projection_survives_arbitrary_strands_colliders_and_grabs() {
+    use hairsim_core::context::StepContext;
+    use hairsim_core::project_constraints;
+    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    for case in 0..3000 {
+        let nodes = 3 + rng.below(NODES - 2);
+        let rest: Vec<Vec3> = (0..nodes)
+            .map(|i| Vec3::new(0.01 * i as Real, 0.0, 0.0))
+            .collect();
+        let mut strand: Strand<NODES> =
+            Strand::from_polyline(&rest, &Material::HUMAN_HAIR).unwrap();
+        let scale = [0.01, 0.3, 10.0, 1.0e4][rng.below(4)];
+        for i in 2..nodes {
+            strand.state.position[i] = match rng.below(4) {
+                0 => strand.state.position[i - 1], // coincident with the previous node
+                1 => Vec3::ZERO,                   // the sphere's centre below
+                _ => rng.point(scale),
+            };
+        }
+        let mut colliders = Vec::new();
+        for _ in 0..rng.below(5) {
+            let shape = match rng.below(4) {
+                0 => Shape::Sphere {
+                    centre: Vec3::ZERO,
+                    radius: rng.next() * 0.2,
+                },
+                1 => Shape::Capsule {
+                    a: rng.point(0.3),
+                    b: rng.point(0.3),
+                    radius: rng.next() * 0.05,
+                },
+                2 => Shape::Plane {
+                    point: rng.point(0.3),
+                    normal: Vec3::Y,
+                },
+                // Not unit: an invalid collider the projection must skip.
+                _ => Shape::Plane {
+                    point: Vec3::ZERO,
+                    normal: Vec3::new(0.0, 3.0, 0.0),
+                },
+            };
+            colliders.push(Collider {
+                shape,
+                attached_to_head: false,
+            });
+        }
+        let grabs: Vec<Grab> = (0..rng.below(4))
+            .map(|_| {
+                Grab::new(
+                    rng.below(2) as u32,
+                    rng.below(nodes + 2) as u32,
+                    rng.point(0.5),
+                    0.1,
+                )
+            })
+            .collect();
+        let mode = if case % 2 == 0 {
+            Mode::Converge
+        } else {
+            Mode::FixedCost
+        };
+        let p = params(mode);
+        let ctx = StepContext::new(&p, Pose::IDENTITY, Pose::IDENTITY, &colliders);
+        let mut report = StepReport::default();
+        let outcome = project_constraints::<Libm, NODES>(&mut strand, &ctx, &grabs, 0, &mut report);
+        let cap = u32::from(p.rod.projection_iterations);
+        assert!(outcome.iterations <= cap, "case {case}");
+        assert!(strand.is_finite(), "case {case}: {:?}", strand.positions());
+        assert!(
+            report.residual.is_finite() && report.max_penetration.is_finite(),
+            "case {case}: {report:?} {outcome:?} {colliders:?} {:?}",
+            strand.positions()
+        );
+        assert!(
+            report.grab_forces.iter().all(|f| f.is_finite()),
+            "case {case}"
+        );
+        assert!(
+            report.collider_forces.iter().all(|f| f.is_finite()),
+            "case {case}"
+        );
+        // Honest: no segment is further from its length than the residual says.
+        let x = strand.positions();
+        for j in 0..nodes - 1 {
+            let e = x[j + 1] - x[j];
+            let l = strand.rest.segment_length[j];
+            let relative = (e.dot(e) - l * l).abs() / (l * l);
+            let prescribed = j < 1
+                || grabs.iter().any(|g| {
+                    g.strand == 0
+                        && (g.node as usize == j || g.node as usize == j + 1)
+                        && g.node >= 2
+                });
+            if !prescribed {
+                assert!(
+                    relative <= outcome.residual * 1.001 + 1e-6,
+                    "case {case}: segment {j} {relative} > {}",
+                    outcome.residual
+                );
+            }
+        }
+    }
 }

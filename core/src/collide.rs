@@ -8,6 +8,12 @@ use crate::math::{Math, Real, Vec3};
 /// Most colliders a world holds.
 pub const MAX_COLLIDERS: usize = 8;
 
+/// Smallest collider radius, m. Below it a contact row's gradient `2(x − c)` underflows f32
+/// (found by the projection fuzz target with a radius of 1e-20 m).
+pub const MIN_RADIUS: Real = 1.0e-5;
+/// Largest collider radius, m.
+pub const MAX_RADIUS: Real = 1.0e4;
+
 /// A collider's geometry.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape {
@@ -122,17 +128,15 @@ impl Shape {
         }
     }
 
-    /// Whether every parameter is finite and in range (radius > 0, unit normal).
+    /// Whether every parameter is finite and in range: a radius from [`MIN_RADIUS`] to
+    /// [`MAX_RADIUS`], a unit plane normal.
     #[must_use]
     pub fn is_valid(&self) -> bool {
         use crate::math::is_finite;
+        let radius_ok = |r: Real| (MIN_RADIUS..=MAX_RADIUS).contains(&r);
         match *self {
-            Shape::Sphere { centre, radius } => {
-                is_finite(centre) && radius.is_finite() && radius > 0.0
-            }
-            Shape::Capsule { a, b, radius } => {
-                is_finite(a) && is_finite(b) && radius.is_finite() && radius > 0.0
-            }
+            Shape::Sphere { centre, radius } => is_finite(centre) && radius_ok(radius),
+            Shape::Capsule { a, b, radius } => is_finite(a) && is_finite(b) && radius_ok(radius),
             Shape::Plane { point, normal } => {
                 is_finite(point)
                     && is_finite(normal)
@@ -237,6 +241,28 @@ mod tests {
                 < 1e-7
         );
         assert!(plane.is_valid() && sphere.is_valid() && capsule.is_valid());
+    }
+
+    /// Regression from the projection fuzz target: a sphere of radius 1e-20 m made a contact
+    /// row whose gradient underflowed; such colliders are refused up front.
+    #[test]
+    fn degenerate_radii_are_refused() {
+        let tiny = Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius: 8.4e-21,
+        };
+        assert!(!tiny.is_valid());
+        let huge = Shape::Capsule {
+            a: Vec3::ZERO,
+            b: Vec3::X,
+            radius: 1.0e5,
+        };
+        assert!(!huge.is_valid());
+        assert!(Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius: MIN_RADIUS
+        }
+        .is_valid());
     }
 
     #[test]

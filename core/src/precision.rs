@@ -44,7 +44,8 @@ pub trait Scalar:
     fn to_f32(self) -> f32;
     /// `|x|`.
     fn abs(self) -> Self;
-    /// Largest integer `≤ x` (exact, the same bits on every target).
+    /// Largest integer `≤ x` (exact, the same bits on every target) for `|x| < 2³¹`; the
+    /// kernels only floor angle ratios. Plain conversions, no libm call.
     fn floor(self) -> Self;
     /// Whether the value is neither infinite nor NaN.
     fn is_finite(self) -> bool;
@@ -68,7 +69,12 @@ impl Scalar for f32 {
     }
     #[inline(always)]
     fn floor(self) -> Self {
-        libm::floorf(self)
+        let truncated = self as i32 as f32;
+        if truncated > self {
+            truncated - 1.0
+        } else {
+            truncated
+        }
     }
     #[inline(always)]
     fn is_finite(self) -> bool {
@@ -94,7 +100,12 @@ impl Scalar for f64 {
     }
     #[inline(always)]
     fn floor(self) -> Self {
-        libm::floor(self)
+        let truncated = self as i64 as f64;
+        if truncated > self {
+            truncated - 1.0
+        } else {
+            truncated
+        }
     }
     #[inline(always)]
     fn is_finite(self) -> bool {
@@ -225,4 +236,26 @@ impl Precision for F64 {
 #[inline(always)]
 pub fn length<P: Precision>(v: P::V) -> P::R {
     P::sqrt(v.dot(v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn floor_matches_libm_on_angle_ratios() {
+        let mut x = -1000.0_f32;
+        while x < 1000.0 {
+            assert_eq!(Scalar::floor(x), libm::floorf(x), "{x}");
+            assert_eq!(
+                Scalar::floor(f64::from(x)),
+                libm::floor(f64::from(x)),
+                "{x}"
+            );
+            x += 0.123_7;
+        }
+        for x in [-2.0_f32, -1.0, -0.0, 0.0, 0.5, -0.5, 1.0, 3.999_999_8] {
+            assert_eq!(Scalar::floor(x), libm::floorf(x), "{x}");
+        }
+    }
 }

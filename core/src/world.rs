@@ -139,7 +139,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         if !collider.shape.is_valid() {
             return Err(ParamError::OutOfRange {
                 field: "collider",
-                allowed: "finite coordinates, radius > 0, unit plane normal",
+                allowed: "finite coordinates, a radius from 1e-5 to 1e4 m, a unit plane normal",
             }
             .into());
         }

@@ -2,90 +2,84 @@
 //! the contact normal onto the surface. Not part of the correction fed back into velocity:
 //! where a node is pushed out, non-penetration wins over the segment's length (DESIGN.md).
 //!
-//! Written branch-free (selects, not early returns) with the same arithmetic as
-//! `Shape::penetration`, so the structure-of-arrays block path can run one collider over all
-//! lanes of a node and give the per-strand path's bits.
+//! Branch-free (selects) with the arithmetic of `Shape::penetration`, on lanes.
 
 use crate::collide::Shape;
 use crate::math::{Math, Real, Vec3};
 
-/// `x` moved out of `shape` if it is inside, and whether it was.
+use super::lane::{Lane, V3};
+
+/// `x` moved out of `shape` where it is inside, and where it was.
 #[inline(always)]
 #[must_use]
-pub fn push_out<M: Math>(shape: &Shape, x: Vec3) -> (Vec3, bool) {
+pub fn push_out<M: Math, T: Lane>(shape: &Shape, x: V3<T>) -> (V3<T>, T::Mask) {
     match *shape {
-        Shape::Sphere { centre, radius } => push_out_of_ball::<M>(x, centre, radius),
+        Shape::Sphere { centre, radius } => push_out_of_ball::<M, T>(x, V3::splat(centre), radius),
         Shape::Capsule { a, b, radius } => {
-            push_out_of_ball::<M>(x, capsule_centre(x, a, b), radius)
+            push_out_of_ball::<M, T>(x, capsule_centre(x, a, b), radius)
         }
-        Shape::Plane { point, normal } => push_out_of_plane(x, point, normal),
+        Shape::Plane { point, normal } => {
+            let normal = V3::splat(normal);
+            let distance = (x - V3::splat(point)).dot(normal);
+            let inside = distance.lt(T::splat(0.0));
+            (V3::select(inside, x - normal.scale(distance), x), inside)
+        }
     }
 }
 
 /// How deep `x` is inside `shape`, m (0 outside): what the report calls penetration.
 #[inline(always)]
 #[must_use]
-pub fn depth<M: Math>(shape: &Shape, x: Vec3) -> Real {
+pub fn depth<M: Math, T: Lane>(shape: &Shape, x: V3<T>) -> T {
     match *shape {
-        Shape::Sphere { centre, radius } => ball_depth::<M>(x, centre, radius),
-        Shape::Capsule { a, b, radius } => ball_depth::<M>(x, capsule_centre(x, a, b), radius),
+        Shape::Sphere { centre, radius } => ball_depth::<M, T>(x, V3::splat(centre), radius),
+        Shape::Capsule { a, b, radius } => ball_depth::<M, T>(x, capsule_centre(x, a, b), radius),
         Shape::Plane { point, normal } => {
-            let distance = (x - point).dot(normal);
-            if distance < 0.0 {
-                -distance
-            } else {
-                0.0
-            }
+            let distance = (x - V3::splat(point)).dot(V3::splat(normal));
+            T::select(distance.lt(T::splat(0.0)), -distance, T::splat(0.0))
         }
     }
 }
 
 /// The closest point to `x` on the capsule's axis `a`–`b`.
 #[inline(always)]
-fn capsule_centre(x: Vec3, a: Vec3, b: Vec3) -> Vec3 {
+fn capsule_centre<T: Lane>(x: V3<T>, a: Vec3, b: Vec3) -> V3<T> {
     let axis = b - a;
     let length2 = axis.dot(axis);
-    let t = if length2 > 0.0 {
-        ((x - a).dot(axis) / length2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    a + axis * t
+    let t = (x - V3::splat(a)).dot(V3::splat(axis)) / T::splat(length2);
+    // clamp(0, 1) as selects; a degenerate axis (a = b) is its end point a.
+    let t = T::select(t.lt(T::splat(0.0)), T::splat(0.0), t);
+    let t = T::select(T::splat(1.0).lt(t), T::splat(1.0), t);
+    let t = T::select(T::mask(length2 > 0.0), t, T::splat(0.0));
+    V3::splat(a) + V3::splat(axis).scale(t)
 }
 
 /// Onto the sphere of `radius` about `centre` along the radial direction (+y from the exact
 /// centre: any fixed direction will do).
 #[inline(always)]
-fn push_out_of_ball<M: Math>(x: Vec3, centre: Vec3, radius: Real) -> (Vec3, bool) {
+fn push_out_of_ball<M: Math, T: Lane>(x: V3<T>, centre: V3<T>, radius: Real) -> (V3<T>, T::Mask) {
     let d = x - centre;
     let distance2 = d.dot(d);
-    let inside = distance2 < radius * radius;
-    let distance = M::sqrt(distance2);
-    let normal = if distance > 0.0 {
-        d * (1.0 / distance)
-    } else {
-        Vec3::Y
-    };
-    let pushed = x + normal * (radius - distance);
-    (if inside { pushed } else { x }, inside)
+    let inside = distance2.lt(T::splat(radius * radius));
+    let distance = distance2.sqrt::<M>();
+    let normal = V3::select(
+        T::splat(0.0).lt(distance),
+        d.scale(T::splat(1.0) / distance),
+        V3::splat(Vec3::Y),
+    );
+    let pushed = x + normal.scale(T::splat(radius) - distance);
+    (V3::select(inside, pushed, x), inside)
 }
 
 #[inline(always)]
-fn ball_depth<M: Math>(x: Vec3, centre: Vec3, radius: Real) -> Real {
+fn ball_depth<M: Math, T: Lane>(x: V3<T>, centre: V3<T>, radius: Real) -> T {
     let d = x - centre;
-    let distance = M::sqrt(d.dot(d));
-    if distance < radius {
-        radius - distance
-    } else {
-        0.0
-    }
-}
-
-#[inline(always)]
-fn push_out_of_plane(x: Vec3, point: Vec3, normal: Vec3) -> (Vec3, bool) {
-    let distance = (x - point).dot(normal);
-    let inside = distance < 0.0;
-    (if inside { x - normal * distance } else { x }, inside)
+    let distance = d.dot(d).sqrt::<M>();
+    T::select(
+        distance.lt(T::splat(radius)),
+        T::splat(radius) - distance,
+        T::splat(0.0),
+    )
 }
 
 #[cfg(test)]
@@ -113,21 +107,26 @@ mod tests {
         let probes = [
             Vec3::new(0.12, 0.01, -0.02),
             Vec3::new(0.01, 0.1, 0.005),
+            Vec3::new(0.01, -0.01, 0.005),
             Vec3::new(0.3, -0.13, 0.0),
             Vec3::new(0.5, 0.5, 0.5),
         ];
         for shape in &shapes {
             for &p in &probes {
-                let (q, inside) = push_out::<Libm>(shape, p);
+                let (q, inside) = push_out::<Libm, Real>(shape, p.into());
+                let q = Vec3::from(q);
                 let contact = shape.penetration::<Libm>(p);
                 assert_eq!(inside, contact.is_some(), "{shape:?} {p}");
                 if let Some(c) = contact {
-                    assert!((depth::<Libm>(shape, p) - c.depth).abs() < 1e-7);
+                    assert!((depth::<Libm, Real>(shape, p.into()) - c.depth).abs() < 1e-7);
                     assert!((q - (p + c.normal * c.depth)).length() < 1e-6);
-                    assert!(depth::<Libm>(shape, q) < 1e-6, "{shape:?} {p} -> {q}");
+                    assert!(
+                        depth::<Libm, Real>(shape, q.into()) < 1e-6,
+                        "{shape:?} {p} -> {q}"
+                    );
                 } else {
                     assert_eq!(q, p);
-                    assert_eq!(depth::<Libm>(shape, p), 0.0);
+                    assert_eq!(depth::<Libm, Real>(shape, p.into()), 0.0);
                 }
             }
         }

@@ -2,19 +2,21 @@
 //! Chentanez 2012, eq. 5): node `i` alone moves onto the sphere of radius `l_i` about the final
 //! node `i − 1` — one-sided and single-pass, the paper's point (TressFX moves both and iterates).
 
-use crate::math::{Math, Real, Vec3};
+use crate::math::Math;
+
+use super::lane::{Lane, V3};
 
 /// `Δx^inex_i = (1 − l_i / |x*_{i−1} − x*_i|)(x*_{i−1} − x*_i)`. Coincident nodes give no
-/// direction and no correction (a select, so the block path computes it branch-free too).
+/// direction and no correction (a select, not a branch).
 #[inline(always)]
 #[must_use]
-pub fn correction<M: Math>(previous: Vec3, x: Vec3, segment_length: Real) -> Vec3 {
+pub fn correction<M: Math, T: Lane>(previous: V3<T>, x: V3<T>, segment_length: T) -> V3<T> {
     let d = previous - x;
-    let length = M::sqrt(d.dot(d));
-    let k = if length > 0.0 {
-        1.0 - segment_length / length
-    } else {
-        0.0
-    };
-    d * k
+    let length = d.dot(d).sqrt::<M>();
+    let k = T::select(
+        T::splat(0.0).lt(length),
+        T::splat(1.0) - segment_length / length,
+        T::splat(0.0),
+    );
+    d.scale(k)
 }

@@ -1,37 +1,34 @@
 //! SB15 Algorithm 1 lines 13–14: external accelerations and the prediction, eq. (1).
 
-use crate::math::{Real, Vec3};
-
+use super::lane::{Lane, V3};
 use super::Setup;
 
 /// External acceleration of a free node: gravity and wind (`setup.base_acceleration`), drag
-/// `−ν v / m` when on, and the caller's acceleration (SPH, outside wind) if any.
+/// `−ν v / m` when on, and the caller's acceleration (SPH, outside wind) where `has_extra`.
 #[inline(always)]
 #[must_use]
-pub fn acceleration(
+pub fn acceleration<T: Lane>(
     setup: &Setup,
-    velocity: Vec3,
-    inverse_mass: Real,
-    extra: Option<Vec3>,
-) -> Vec3 {
-    let mut a = setup.base_acceleration;
+    velocity: V3<T>,
+    inverse_mass: T,
+    extra: V3<T>,
+    has_extra: T::Mask,
+) -> V3<T> {
+    let mut a = V3::splat(setup.base_acceleration);
     if setup.drag {
-        a -= velocity * (setup.drag_coefficient * inverse_mass);
+        a = a - velocity.scale(T::splat(setup.drag_coefficient) * inverse_mass);
     }
-    if let Some(extra) = extra {
-        a += extra;
-    }
-    a
+    V3::select(has_extra, a + extra, a)
 }
 
 /// SB15 eq. (1): `x* = x + v Δt + a Δt²` (coefficient 1, not ½: symplectic Euler).
 #[inline(always)]
 #[must_use]
-pub fn predicted_position(
+pub fn predicted_position<T: Lane>(
     setup: &Setup,
-    position: Vec3,
-    velocity: Vec3,
-    acceleration: Vec3,
-) -> Vec3 {
-    position + velocity * setup.dt + acceleration * setup.dt_squared
+    position: V3<T>,
+    velocity: V3<T>,
+    acceleration: V3<T>,
+) -> V3<T> {
+    position + velocity.scale(T::splat(setup.dt)) + acceleration.scale(T::splat(setup.dt_squared))
 }

@@ -45,7 +45,9 @@ impl<const N: usize> DftlRest<N> {
             let edge = points[i] - points[i - 1];
             let length = M::length(edge);
             rest.local_rest[i] = math::rotate(math::quat_conjugate(frame_i), edge);
-            (frame_i, tangent_i) = frame::transport::<M>(frame_i, tangent_i, edge, length);
+            let (next_frame, next_tangent) =
+                frame::transport::<M, Real>(frame_i.into(), tangent_i.into(), edge.into(), length);
+            (frame_i, tangent_i) = (next_frame.into(), next_tangent.into());
             distance += length;
             rest.root_distance[i] = distance;
         }

@@ -3,35 +3,46 @@
 //! fractions are per step at the world's `dt` (`DftlParams::at_step`) and fade linearly with
 //! rest distance from the root.
 
-use crate::math::{self, Quat, Real, Vec3};
-
+use super::lane::{Lane, Q, V3};
 use super::Setup;
 
 /// SB15 eq. (11): `Δx^gbl_i = s_g (p_i − x*_i)`, `p_i = T_head(x̂_i)` — the rest position
 /// carried rigidly by the head.
 #[inline(always)]
 #[must_use]
-pub fn global_correction(setup: &Setup, rest_position: Vec3, root_distance: Real, x: Vec3) -> Vec3 {
-    let s = setup.coefficients.global_shape
-        * (1.0 - setup.coefficients.global_shape_fade * root_distance);
-    let target = setup.head_rotation * rest_position + setup.head_position;
-    (target - x) * s
+pub fn global_correction<T: Lane>(
+    setup: &Setup,
+    rest_position: V3<T>,
+    root_distance: T,
+    x: V3<T>,
+) -> V3<T> {
+    let c = &setup.coefficients;
+    let s =
+        T::splat(c.global_shape) * (T::splat(1.0) - T::splat(c.global_shape_fade) * root_distance);
+    let r = &setup.head_rotation;
+    // R x̂ + t, summed column by column as glam's `Mat3 * Vec3`.
+    let target = V3::splat(r.x_axis).scale(rest_position.x)
+        + V3::splat(r.y_axis).scale(rest_position.y)
+        + V3::splat(r.z_axis).scale(rest_position.z)
+        + V3::splat(setup.head_position);
+    (target - x).scale(s)
 }
 
 /// SB15 eq. (12): `Δx^lcl_i = s_l (p^{i−1}_i − x*_i)`, `p^{i−1}_i = x*_{i−1} + R_{i−1} r_i` — the
 /// rest offset carried by the (already final) previous node's frame.
 #[inline(always)]
 #[must_use]
-pub fn local_correction(
+pub fn local_correction<T: Lane>(
     setup: &Setup,
-    previous: Vec3,
-    previous_frame: Quat,
-    local_rest: Vec3,
-    root_distance: Real,
-    x: Vec3,
-) -> Vec3 {
-    let s = setup.coefficients.local_shape
-        * (1.0 - setup.coefficients.local_shape_fade * root_distance);
-    let target = previous + math::rotate(previous_frame, local_rest);
-    (target - x) * s
+    previous: V3<T>,
+    previous_frame: Q<T>,
+    local_rest: V3<T>,
+    root_distance: T,
+    x: V3<T>,
+) -> V3<T> {
+    let c = &setup.coefficients;
+    let s =
+        T::splat(c.local_shape) * (T::splat(1.0) - T::splat(c.local_shape_fade) * root_distance);
+    let target = previous + previous_frame.rotate(local_rest);
+    (target - x).scale(s)
 }

@@ -256,20 +256,23 @@ fn magnitude(p: Vec3) -> Real {
 }
 
 /// What f32 positions can resolve of a constraint's value. Each coordinate is rounded to
-/// `ε|x|`, so `e` is uncertain by `ε·max|x|` per component and `e·e` by `2ε|e|₁·max|x|`
+/// `ε|x|/2`, so `e` is uncertain by `ε·max|x|` per component and `e·e` by `2ε|e|₁·max|x|`
 /// (plus its own rounding, `ε e·e`); a contact depth by `ε` of the coordinates involved.
-/// With 1 cm segments 0.2 m from the origin that is ~5e-6 of `ê·ê`: near or above the
-/// default tolerance 1e-6, which Newton steps then cannot reach (they stall at the rounding).
-/// Rows within this floor count as satisfied; the reported residual stays the true value.
+/// Newton steps at that level only move nodes by a rounding and the residual wanders within
+/// it (measured: up to ~1.5× the bound once the linear solve's own rounding adds in), so the
+/// floor is twice the bound. With 1 cm segments 0.1–0.4 m from the origin that is 5e-6 to
+/// 2e-5 of `ê·ê`: above the default tolerance 1e-6, which the iteration would otherwise
+/// chase for its whole cap. Rows within this floor count as met; the reported residual
+/// stays the true value.
 #[must_use]
 pub fn resolution_floor(is_contact: bool, a: Vec3, b: Vec3, length_scale: Real) -> Real {
     let eps = Real::EPSILON;
     let m = magnitude(a).max(magnitude(b));
     if is_contact {
-        2.0 * eps * (m + length_scale)
+        4.0 * eps * (m + length_scale)
     } else {
         let e = b - a;
-        2.0 * eps * (e.x.abs() + e.y.abs() + e.z.abs()) * m + eps * e.dot(e)
+        4.0 * eps * (e.x.abs() + e.y.abs() + e.z.abs()) * m + 2.0 * eps * e.dot(e)
     }
 }
 
@@ -360,7 +363,9 @@ pub fn evaluate<M: Math, const N: usize>(
                             Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
                             Shape::Plane { point, .. } => magnitude(point),
                         };
-                        rows.converged = depth <= resolution_floor(true, x[i], x[i], reach);
+                        // Past 1 % of the segment f32 resolves nothing: not converged.
+                        let floor = resolution_floor(true, x[i], x[i], reach).min(0.01 * scale);
+                        rows.converged = depth <= floor;
                     }
                 }
                 let (value, gradient) = contact(shape, normal, depth);
@@ -385,7 +390,7 @@ pub fn evaluate<M: Math, const N: usize>(
             }
             // The resolution floor only matters while every row so far is met.
             if rows.converged && row.value.abs() > tolerance * rest2 {
-                let floor = resolution_floor(false, x[i], x[i + 1], 0.0);
+                let floor = resolution_floor(false, x[i], x[i + 1], 0.0).min(0.01 * rest2);
                 rows.converged = row.value.abs() <= floor;
             }
             let first = previous_segment.unwrap_or(rows.count);

@@ -11,7 +11,8 @@
 //! 3. solve `(∇C M⁻¹ ∇Cᵀ) δλ = C(x_k)` with a banded LDLᵀ — [`banded`]: each node's collision
 //!    rows are eliminated first at their node (no fill), leaving the segments' tridiagonal
 //!    band, so contacts cost O(contacts) and never widen the band;
-//! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`.
+//! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`, scaled down whole if it would move a node further
+//!    than ten strand lengths (a trust region that only garbage input meets).
 //!
 //! Root coupling and grabs are *prescribed* nodes (`w = 0`, no rows): nodes 0 and 1 were set
 //! by root coupling, grabbed nodes are set to their targets here. Then
@@ -69,10 +70,18 @@ struct Workspace<const N: usize> {
     multipliers: [Real; N],
     /// `Σ_k −∇_{x_g}C_kᵀ δλ_k` per grab slot: the segments' pull on the grabbed node, × h².
     grab_pull: [Vec3; MAX_GRABS],
+    /// One iteration's `Δx` per node.
+    step: [Vec3; N],
+    /// Longest move of a node in one iteration: ten times the strand's rest length, m.
+    trust_radius: Real,
     /// `Σ_k ∇_{x_i}C_kᵀ δλ_k` over each collider's rows: the hair's push on it, × h².
     collider_push: [Vec3; MAX_COLLIDERS],
     truncated: bool,
 }
+
+/// The trust radius of one projection iteration, in strand rest lengths (see
+/// `solve_and_move`).
+const TRUST_RADIUS_IN_STRAND_LENGTHS: Real = 10.0;
 
 /// Compile-time check that row and node indices fit the `u16`s the rows store.
 struct IndexFits<const N: usize>;
@@ -88,9 +97,10 @@ impl<const N: usize> IndexFits<N> {
 /// iterations, residual, stretch, contacts and forces to `report`.
 ///
 /// Runs when any of the effects `inextensibility`, `collisions`, `grabs` is on, and builds
-/// only the rows of those that are. Callable on any strand, colliders and grabs (the fuzz
-/// target drives it): it never panics, and degenerate input (coincident nodes, a node at a
-/// sphere's centre, huge stretch) gives finite positions and an honest residual.
+/// only the rows of those that are. Callable on any strand, colliders and grabs (so that a
+/// fuzz target can drive it with a `StepContext::new` of its own): it never panics, and
+/// degenerate input (coincident nodes, a node at a sphere's centre, huge stretch) gives
+/// finite positions and an honest residual.
 pub fn project_constraints<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -124,12 +134,52 @@ pub fn project_constraints<M: Math, const N: usize>(
         fixed_cost: ctx.params.mode == Mode::FixedCost,
     };
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
-    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    let mut outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    keep_finite(strand, &work, n, ctx.inv_dt, &mut outcome);
     report.ran(Stage::Velocity);
     update_velocities(strand, &work.predicted, ctx.inv_dt);
     record::<M, N>(strand, ctx, &outcome, &work, report);
     record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
     outcome
+}
+
+/// Finite in, finite out: if a degenerate configuration (found by the fuzz target: a capsule,
+/// several planes and a grab on one node) overflowed an iterate, the strand keeps the
+/// positions it came in with — finite, unprojected — and the outcome says the constraints are
+/// not met, with the inextensibility residual of those positions and one more dropped row.
+/// "Overflowed" includes a finite move so large that the velocity update `Δx/h` would not be.
+fn keep_finite<const N: usize>(
+    strand: &mut Strand<N>,
+    work: &Workspace<N>,
+    n: usize,
+    inv_dt: Real,
+    outcome: &mut Outcome,
+) {
+    let position = &mut strand.state.position;
+    let finite = position
+        .iter()
+        .zip(work.predicted.iter())
+        .take(n)
+        .all(|(x, p)| crate::math::is_finite((*x - *p) * inv_dt));
+    if finite {
+        return;
+    }
+    *position = work.predicted;
+    outcome.converged = false;
+    outcome.dropped_rows += 1;
+    let mut residual: Real = 0.0;
+    for j in 1..n.saturating_sub(1) {
+        let e = position[j + 1] - position[j];
+        let rest = strand.rest.segment_length[j];
+        let relative = (e.dot(e) - rest * rest).abs() / (rest * rest);
+        if relative.is_nan() || relative > residual {
+            residual = relative;
+        }
+    }
+    outcome.residual = outcome.residual.max(residual);
+    if !outcome.residual.is_finite() {
+        outcome.residual = Real::MAX;
+    }
 }
 
 impl<const N: usize> Workspace<N> {
@@ -159,6 +209,14 @@ impl<const N: usize> Workspace<N> {
             band: [[0.0; banded::MAX_HALF_BANDWIDTH + 1]; N],
             multipliers: [0.0; N],
             grab_pull: [Vec3::ZERO; MAX_GRABS],
+            step: [Vec3::ZERO; N],
+            trust_radius: TRUST_RADIUS_IN_STRAND_LENGTHS
+                * strand
+                    .rest
+                    .segment_length
+                    .iter()
+                    .take(n.saturating_sub(1))
+                    .sum::<Real>(),
             collider_push: [Vec3::ZERO; MAX_COLLIDERS],
             truncated: false,
         }
@@ -232,7 +290,7 @@ fn iterate<M: Math, const N: usize>(
         if k == cap || (outcome.converged && !layout.fixed_cost) {
             break;
         }
-        match solve_and_move(strand, held, work) {
+        match solve_and_move::<M, N>(strand, held, work) {
             Some(dropped) => outcome.dropped_rows += dropped,
             // A non-finite multiplier (overflow on absurd input): keep x_k, stop, report.
             None => {
@@ -248,7 +306,7 @@ fn iterate<M: Math, const N: usize>(
 /// One projection step: `(∇C M⁻¹ ∇Cᵀ) δλ = C`, `x ← x − M⁻¹ ∇Cᵀ δλ`, and the forces' sums.
 /// Returns the rows dropped at a singular pivot, or `None` (and leaves `x` alone) when the
 /// multipliers are not finite.
-fn solve_and_move<const N: usize>(
+fn solve_and_move<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     held: &GrabbedNodes,
     work: &mut Workspace<N>,
@@ -269,34 +327,66 @@ fn solve_and_move<const N: usize>(
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
-    // Segments: x_i −= w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact).
-    let position = &mut strand.state.position;
+    // Δx: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact),
+    // contacts by −d_i.
+    let step = &mut work.step;
+    *step = [Vec3::ZERO; N];
     for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
-        for ((&node, &gradient), &projected) in row
-            .nodes
-            .iter()
-            .zip(row.gradient.iter())
-            .zip(row.projected.iter())
-        {
+        for (&node, &projected) in row.nodes.iter().zip(row.projected.iter()) {
             let i = usize::from(node);
             let w = work.nodes.inverse_mass.get(i).copied().unwrap_or(0.0);
-            if w > 0.0 {
-                if let Some(x) = position.get_mut(i) {
-                    *x -= projected * (w * lambda);
-                }
-            } else if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
-                *pull -= gradient * lambda;
+            if let (true, Some(dx)) = (w > 0.0, step.get_mut(i)) {
+                *dx -= projected * (w * lambda);
             }
         }
     }
-    // Contacts: x_i −= d_i, and the multipliers the eliminated rows would have had.
-    for (i, x) in position.iter_mut().enumerate().take(n) {
+    for (dx, contacts) in step.iter_mut().zip(work.rows.contacts.iter()).take(n) {
+        if contacts.kept > 0 {
+            *dx -= contacts.displacement;
+        }
+    }
+    // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
+    // asks for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled
+    // down whole (its direction kept): garbage then converges slowly instead of exploding.
+    // Legitimate iterates do overshoot: in a violent step (the firmware scene's strand 1 at
+    // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
+    // the next ones converged; a radius of one strand length cut that short and broke the
+    // iteration. Hence ten strand lengths.
+    let mut longest2: Real = 0.0;
+    for dx in step.iter().take(n) {
+        let d2 = dx.dot(*dx);
+        // Not `max`, which would drop a NaN.
+        if d2.is_nan() || d2 > longest2 {
+            longest2 = d2;
+        }
+    }
+    if !longest2.is_finite() {
+        return None;
+    }
+    let bound = work.trust_radius;
+    let scale = if longest2 > bound * bound {
+        bound / M::sqrt(longest2)
+    } else {
+        1.0
+    };
+    for (x, dx) in strand.state.position.iter_mut().zip(step.iter()).take(n) {
+        *x += *dx * scale;
+    }
+    // Forces from the multipliers actually applied (`scale · δλ`).
+    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
+        for (&node, &gradient) in row.nodes.iter().zip(row.gradient.iter()) {
+            let i = usize::from(node);
+            if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
+                *pull -= gradient * (lambda * scale);
+            }
+        }
+    }
+    for i in 0..n {
         let contacts = work.rows.contacts[i];
         if contacts.kept == 0 {
             continue;
         }
         let segment_pull = segment_pull_on_node(&work.rows, multipliers, i);
-        *x -= contacts.displacement;
         let w = work.nodes.inverse_mass[i];
         let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
         let kept = usize::from(contacts.kept);
@@ -309,10 +399,10 @@ fn solve_and_move<const N: usize>(
         {
             let c = usize::from(c);
             if let Some(push) = work.collider_push.get_mut(c) {
-                *push += gradient * lambda;
+                *push += gradient * (lambda * scale);
             }
             if let Some(sum) = work.contacts.multipliers[i].get_mut(c) {
-                *sum += lambda;
+                *sum += lambda * scale;
             }
         }
     }

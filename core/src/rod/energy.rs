@@ -20,7 +20,7 @@
 
 use super::twist::binormal_direction;
 use super::{ClampedSegments, ElasticTerms};
-use crate::frames::{curvature_binormal, material_frame, parallel_transport, perpendicular_unit};
+use crate::frames::{curvature_binormal, parallel_transport, perpendicular_unit};
 use crate::math::Real;
 use crate::precision::{Precision, Scalar, Vector};
 
@@ -172,6 +172,8 @@ pub struct RodFrames<P: Precision, const N: usize> {
     pub edge: [P::V; N],
     /// `|e^j|`.
     pub length: [P::R; N],
+    /// `1 / |e^j|`.
+    pub inverse_length: [P::R; N],
     /// `t^j = e^j / |e^j|`.
     pub tangent: [P::V; N],
     /// `(κb)_i`, `i = 1 … n`.
@@ -197,6 +199,7 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
             nodes: positions.len().min(N),
             edge: [zero; N],
             length: [P::R::ZERO; N],
+            inverse_length: [P::R::ZERO; N],
             tangent: [zero; N],
             curvature_binormal: [zero; N],
             denominator: [P::R::ONE; N],
@@ -210,7 +213,8 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
         for j in 0..segments {
             let e = positions[j + 1] - positions[j];
             let length = P::sqrt(e.dot(e));
-            let t = e * (P::R::ONE / length);
+            let inverse_length = P::R::ONE / length;
+            let t = e * inverse_length;
             let u = if j == 0 {
                 root_frame
             } else {
@@ -218,6 +222,7 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
             };
             f.edge[j] = e;
             f.length[j] = length;
+            f.inverse_length[j] = inverse_length;
             f.tangent[j] = t;
             f.bishop_u[j] = u;
             f.bishop_v[j] = t.cross(u);
@@ -333,7 +338,9 @@ pub fn elastic_energy<P: Precision, const N: usize>(
 ) -> P::R {
     let cos_sin = material_angles::<P, N>(theta);
     let mut energy = P::R::ZERO;
-    for i in 1..=frames.interior() {
+    // A shorter `theta` truncates the strand rather than reading past it.
+    let n = frames.interior().min(theta.len().saturating_sub(1));
+    for i in 1..=n {
         for k in 0..2 {
             energy += node_bending_energy(frames, rest, terms, i, k, cos_sin[i - 1 + k]);
         }
@@ -362,10 +369,14 @@ fn bending_terms<P: Precision, const N: usize>(
         b[0] * (omega[0] - rest_omega[0]) * inv_l,
         b[1] * (omega[1] - rest_omega[1]) * inv_l,
     ];
-    let (m1, m2) = material_frame::<P>(frames.bishop_u[j], frames.bishop_v[j], cos_sin);
+    // m2 (Bδ)₁ − m1 (Bδ)₂ in the Bishop frame (m1 = c u + s v, m2 = −s u + c v), without
+    // forming the material frame.
+    let [c, s] = cos_sin;
+    let along_u = -(s * b_delta[0] + c * b_delta[1]);
+    let along_v = c * b_delta[0] - s * b_delta[1];
     (
         omega[1] * b_delta[0] - omega[0] * b_delta[1],
-        m2 * b_delta[0] - m1 * b_delta[1],
+        frames.bishop_u[j] * along_u + frames.bishop_v[j] * along_v,
     )
 }
 
@@ -424,9 +435,13 @@ pub fn twist_derivative<P: Precision, const N: usize>(
     terms: ElasticTerms,
     j: usize,
 ) -> P::R {
-    let (s, c) = P::sin_cos(theta[j]);
+    let Some(&angle) = theta.get(j) else {
+        return P::R::ZERO;
+    };
+    let (s, c) = P::sin_cos(angle);
+    let n = frames.interior().min(theta.len().saturating_sub(1));
     bending_twist_derivative(frames, rest, terms, j, [c, s])
-        + twist_twist_derivative(rest, terms, theta, j, frames.interior())
+        + twist_twist_derivative(rest, terms, theta, j, n)
 }
 
 /// The elastic forces (Kmoch Sec. 7.2, BWR08 Sec. 7):
@@ -499,8 +514,8 @@ pub fn elastic_forces_with_angles<P: Precision, const N: usize>(
         let t_prev = frames.tangent[k - 1];
         let t_next = frames.tangent[k];
         let kb_unit = t_prev.cross(t_next) * (two / (P::R::ONE + t_prev.dot(t_next)));
-        let psi_prev = kb_unit * (half / frames.length[k - 1]);
-        let psi_next = -(kb_unit * (half / frames.length[k]));
+        let psi_prev = kb_unit * (half * frames.inverse_length[k - 1]);
+        let psi_next = -(kb_unit * (half * frames.inverse_length[k]));
         forces[k - 1] += psi_prev * suffix - a;
         forces[k + 1] += psi_next * suffix - c;
         forces[k] += a + c - (psi_prev + psi_next) * suffix;

@@ -168,7 +168,7 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
     if segments == 0 {
         return;
     }
-    let n = frames.interior();
+    let n = frames.interior().min(segments - 1);
     // (cos θ^{j−1}, sin θ^{j−1}), carried down the strand: one sin_cos per strand (and per
     // clamped segment), none per node.
     let (s, c) = P::sin_cos(theta[0]);
@@ -366,7 +366,7 @@ pub fn twist_newton_system<P: Precision, const N: usize>(
     gauss_newton: &mut [P::R; N],
     coupling: &mut [P::R; N],
 ) {
-    let n = frames.interior();
+    let n = frames.interior().min(theta.len().saturating_sub(1));
     let two_beta = P::R::of(2.0) * twist_stiffness(rest, terms);
     let cos_sin = material_angles::<P, N>(theta);
     for j in 0..theta.len().min(N) {

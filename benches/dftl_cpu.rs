@@ -1,0 +1,187 @@
+//! DFTL throughput per CPU-second, for a shared machine where wall-clock benchmarks are noisy:
+//! each configuration steps a fixed number of vertex-steps and divides by the CPU time the
+//! process used (Linux `/proc/self/stat` utime + stime, 10 ms ticks; runs last ≥ 0.3 s), and by
+//! the wall time. Sizes of Sánchez-Banderas 2015 Table 2; per-strand path vs blocks of 8 and 16
+//! lanes, DFTL (gravity + inextensibility) and DFTL + shape; the 16-lane blocks also split over
+//! two threads by a fixed partition (CPU time then counts both threads).
+//!
+//! `cargo bench -p hairsim-benches --bench dftl_cpu`
+
+use std::time::Instant;
+
+use hairsim_core::context::StepContext;
+use hairsim_core::dftl::{step_blocks, DftlBlock};
+use hairsim_core::{
+    step_strands, Effect, Effects, Material, Math, Params, Real, Shake, Solver, StepReport, Strand,
+    Vec3,
+};
+
+/// `libm`'s trigonometry, the hardware's correctly rounded square root (vectorisable).
+#[derive(Clone, Copy, Debug, Default)]
+struct HostMath;
+
+impl Math for HostMath {
+    const NAME: &'static str = "host-sqrt";
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        x.sqrt()
+    }
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        libm::sincosf(x)
+    }
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        libm::atan2f(y, x)
+    }
+}
+
+/// CPU seconds used by this process so far (user + system).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|f| f.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+fn strands<const N: usize>(count: usize) -> Vec<Strand<N>> {
+    (0..count)
+        .map(|s| {
+            let a = s as Real * 2.399_963;
+            let up = (s as Real + 0.5) / count as Real;
+            let r = (1.0 - up * up).sqrt();
+            let normal = Vec3::new(r * a.cos(), up, r * a.sin());
+            let side = normal.cross(Vec3::Y).normalize_or(Vec3::X);
+            let points: Vec<Vec3> = (0..N)
+                .map(|i| {
+                    let t = i as Real * 0.01;
+                    normal * (0.1 + t) + side * (0.003 * (30.0 * t).sin())
+                })
+                .collect();
+            Strand::from_polyline(&points, &Material::HUMAN_HAIR).unwrap()
+        })
+        .collect()
+}
+
+fn contexts(shape: bool, steps: u32) -> Vec<StepContext> {
+    let mut effects = Effects::from_slice(&[Effect::Gravity, Effect::Inextensibility]);
+    if shape {
+        effects = effects.with(Effect::Shape);
+    }
+    let p = Params {
+        solver: Solver::Dftl,
+        effects,
+        ..Params::DEFAULT
+    };
+    let c = p.dftl.at_step(p.dt);
+    let shake = Shake::TEN_RAD_PER_S;
+    (0..steps)
+        .map(|k| {
+            let t = k as Real * p.dt;
+            let (a, b) = (
+                shake.pose_at::<HostMath>(t),
+                shake.pose_at::<HostMath>(t + p.dt),
+            );
+            StepContext::with_coefficients(&p, c, a, b, &[])
+        })
+        .collect()
+}
+
+fn measure(label: &str, vertices: usize, steps: u32, mut run: impl FnMut()) {
+    let (cpu0, wall0) = (cpu_seconds(), Instant::now());
+    run();
+    let (cpu, wall) = (cpu_seconds() - cpu0, wall0.elapsed().as_secs_f64());
+    let work = vertices as f64 * f64::from(steps) / 1e6;
+    println!(
+        "{label:<40} {:>8.1} M/CPU-s {:>8.1} M/wall-s",
+        work / cpu.max(0.01),
+        work / wall
+    );
+}
+
+fn size<const N: usize>(count: usize) {
+    let vertices = count * N;
+    // About 20 M vertex-steps per run.
+    let steps = (20_000_000 / vertices).max(10) as u32;
+    for shape in [false, true] {
+        let ctx = contexts(shape, steps);
+        let name = if shape { "dftl+shape" } else { "dftl" };
+        let mut report = StepReport::default();
+        let mut s = strands::<N>(count);
+        measure(
+            &format!("{count} x {N} per-strand {name}"),
+            vertices,
+            steps,
+            || {
+                for c in &ctx {
+                    step_strands::<HostMath, N>(c, &mut s, 0, &[], None, &mut report);
+                }
+            },
+        );
+        let source = strands::<N>(count);
+        let mut b8: Vec<DftlBlock<8, N>> = source.chunks(8).map(DftlBlock::from_strands).collect();
+        measure(
+            &format!("{count} x {N} block-8 {name}"),
+            vertices,
+            steps,
+            || {
+                for c in &ctx {
+                    step_blocks::<HostMath, 8, N>(c, &mut b8, 0, None, &mut report);
+                }
+            },
+        );
+        let mut b16: Vec<DftlBlock<16, N>> =
+            source.chunks(16).map(DftlBlock::from_strands).collect();
+        measure(
+            &format!("{count} x {N} block-16 {name}"),
+            vertices,
+            steps,
+            || {
+                for c in &ctx {
+                    step_blocks::<HostMath, 16, N>(c, &mut b16, 0, None, &mut report);
+                }
+            },
+        );
+        measure(
+            &format!("{count} x {N} block-16 2 threads {name}"),
+            vertices,
+            steps,
+            // A scoped thread per step (a harness without a pool), so both halves finish
+            // each step before the next starts.
+            || {
+                let half = b16.len().div_ceil(2);
+                for c in &ctx {
+                    let (left, right) = b16.split_at_mut(half);
+                    std::thread::scope(|scope| {
+                        scope.spawn(|| {
+                            let mut r = StepReport::default();
+                            step_blocks::<HostMath, 16, N>(c, left, 0, None, &mut r);
+                        });
+                        let mut r = StepReport::default();
+                        let first = (half * 16) as u32;
+                        step_blocks::<HostMath, 16, N>(c, right, first, None, &mut r);
+                    });
+                }
+            },
+        );
+        std::hint::black_box(&report);
+    }
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return;
+    }
+    size::<8>(1024);
+    size::<32>(1024);
+    size::<32>(4096);
+    size::<64>(4096);
+    size::<64>(16384);
+}

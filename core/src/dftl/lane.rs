@@ -1,0 +1,404 @@
+//! Lanes: the arithmetic every DFTL stage is written in, generic over a lane type `T` so the
+//! per-strand path (`T = Real`) and the block path (`T = Wide<W>`, one strand per lane) run
+//! the very same sequence of IEEE operations on each strand — the same bits by construction
+//! (Box2D's `b2FloatW` with its scalar fallback).
+//!
+//! Every operation on [`Wide`] is a loop over its `W` lanes with no cross-lane term, which the
+//! compiler turns into packed instructions; nothing ever sums across lanes. Comparisons give a
+//! mask and branches become [`Lane::select`], so a stage has no data-dependent branch.
+//! `V3`/`Q` spell out their sums in the order of glam's scalar `Vec3` and `math.rs`'s
+//! quaternion helpers.
+
+use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+use crate::math::{Math, Quat, Real, Vec3};
+
+/// A scalar or a fixed-width bundle of scalars, operated on lane by lane.
+pub trait Lane:
+    Copy
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// One boolean per lane.
+    type Mask: Copy
+        + BitAnd<Output = Self::Mask>
+        + BitOr<Output = Self::Mask>
+        + Not<Output = Self::Mask>;
+    /// `x` in every lane.
+    fn splat(x: Real) -> Self;
+    /// Correctly rounded square root through the backend `M`.
+    fn sqrt<M: Math>(self) -> Self;
+    /// `|x|`.
+    fn abs(self) -> Self;
+    /// `f32::max` per lane (a NaN operand gives the other).
+    fn max(self, other: Self) -> Self;
+    /// `self < other` per lane.
+    fn lt(self, other: Self) -> Self::Mask;
+    /// Whether each lane is finite.
+    fn finite(self) -> Self::Mask;
+    /// `if mask { a } else { b }` per lane.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// A mask with `value` in every lane.
+    fn mask(value: bool) -> Self::Mask;
+}
+
+impl Lane for Real {
+    type Mask = bool;
+    #[inline(always)]
+    fn splat(x: Real) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt<M: Math>(self) -> Self {
+        M::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Real::abs(self)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Real::max(self, other)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> bool {
+        self < other
+    }
+    #[inline(always)]
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask {
+            a
+        } else {
+            b
+        }
+    }
+    #[inline(always)]
+    fn mask(value: bool) -> bool {
+        value
+    }
+}
+
+/// `W` scalars, one per strand of a block.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Wide<const W: usize>(pub [Real; W]);
+
+/// `W` booleans.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WideMask<const W: usize>(pub [bool; W]);
+
+macro_rules! lanewise {
+    ($trait:ident, $method:ident, $ty:ident, $op:tt) => {
+        impl<const W: usize> $trait for $ty<W> {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, other: Self) -> Self {
+                $ty(core::array::from_fn(|l| self.0[l] $op other.0[l]))
+            }
+        }
+    };
+}
+lanewise!(Add, add, Wide, +);
+lanewise!(Sub, sub, Wide, -);
+lanewise!(Mul, mul, Wide, *);
+lanewise!(Div, div, Wide, /);
+lanewise!(BitAnd, bitand, WideMask, &);
+lanewise!(BitOr, bitor, WideMask, |);
+
+impl<const W: usize> Neg for Wide<W> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        Wide(self.0.map(|x| -x))
+    }
+}
+
+impl<const W: usize> Not for WideMask<W> {
+    type Output = Self;
+    #[inline(always)]
+    fn not(self) -> Self {
+        WideMask(self.0.map(|x| !x))
+    }
+}
+
+impl<const W: usize> Lane for Wide<W> {
+    type Mask = WideMask<W>;
+    #[inline(always)]
+    fn splat(x: Real) -> Self {
+        Wide([x; W])
+    }
+    #[inline(always)]
+    fn sqrt<M: Math>(self) -> Self {
+        Wide(self.0.map(M::sqrt))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Wide(self.0.map(Real::abs))
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Wide(core::array::from_fn(|l| self.0[l].max(other.0[l])))
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> WideMask<W> {
+        WideMask(core::array::from_fn(|l| self.0[l] < other.0[l]))
+    }
+    #[inline(always)]
+    fn finite(self) -> WideMask<W> {
+        WideMask(self.0.map(Real::is_finite))
+    }
+    #[inline(always)]
+    fn select(mask: WideMask<W>, a: Self, b: Self) -> Self {
+        Wide(core::array::from_fn(|l| {
+            if mask.0[l] {
+                a.0[l]
+            } else {
+                b.0[l]
+            }
+        }))
+    }
+    #[inline(always)]
+    fn mask(value: bool) -> WideMask<W> {
+        WideMask([value; W])
+    }
+}
+
+/// A vector of lanes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3<T> {
+    /// x.
+    pub x: T,
+    /// y.
+    pub y: T,
+    /// z.
+    pub z: T,
+}
+
+impl<T: Lane> V3<T> {
+    /// `v` in every lane.
+    #[inline(always)]
+    pub fn splat(v: Vec3) -> Self {
+        V3 {
+            x: T::splat(v.x),
+            y: T::splat(v.y),
+            z: T::splat(v.z),
+        }
+    }
+    /// Zero.
+    #[inline(always)]
+    pub fn zero() -> Self {
+        Self::splat(Vec3::ZERO)
+    }
+    /// `self · s`.
+    #[inline(always)]
+    pub fn scale(self, s: T) -> Self {
+        V3 {
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
+        }
+    }
+    /// `x·x' + y·y' + z·z'`, summed left to right.
+    #[inline(always)]
+    pub fn dot(self, o: Self) -> T {
+        self.x * o.x + self.y * o.y + self.z * o.z
+    }
+    /// `self × o`.
+    #[inline(always)]
+    pub fn cross(self, o: Self) -> Self {
+        V3 {
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
+        }
+    }
+    /// Per lane `if mask { a } else { b }`.
+    #[inline(always)]
+    pub fn select(mask: T::Mask, a: Self, b: Self) -> Self {
+        V3 {
+            x: T::select(mask, a.x, b.x),
+            y: T::select(mask, a.y, b.y),
+            z: T::select(mask, a.z, b.z),
+        }
+    }
+    /// Whether every component is finite, per lane.
+    #[inline(always)]
+    pub fn finite(self) -> T::Mask {
+        self.x.finite() & self.y.finite() & self.z.finite()
+    }
+}
+
+impl<T: Lane> Add for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(self, o: Self) -> Self {
+        V3 {
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
+        }
+    }
+}
+
+impl<T: Lane> Sub for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(self, o: Self) -> Self {
+        V3 {
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
+        }
+    }
+}
+
+impl From<Vec3> for V3<Real> {
+    #[inline(always)]
+    fn from(v: Vec3) -> Self {
+        V3 {
+            x: v.x,
+            y: v.y,
+            z: v.z,
+        }
+    }
+}
+
+impl From<V3<Real>> for Vec3 {
+    #[inline(always)]
+    fn from(v: V3<Real>) -> Self {
+        Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+/// A quaternion of lanes (`math.rs`'s scalar formulas).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Q<T> {
+    /// x.
+    pub x: T,
+    /// y.
+    pub y: T,
+    /// z.
+    pub z: T,
+    /// w.
+    pub w: T,
+}
+
+impl<T: Lane> Q<T> {
+    /// `q` in every lane.
+    #[inline(always)]
+    pub fn splat(q: Quat) -> Self {
+        Q {
+            x: T::splat(q.x),
+            y: T::splat(q.y),
+            z: T::splat(q.z),
+            w: T::splat(q.w),
+        }
+    }
+    /// Hamilton product `self · b` (as `math::quat_mul`).
+    #[inline(always)]
+    pub fn product(self, b: Self) -> Self {
+        let a = self;
+        Q {
+            x: a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+            y: a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+            z: a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+            w: a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+        }
+    }
+    /// Rotates `v` (as `math::rotate`): `v + 2w (u × v) + 2 u × (u × v)`.
+    #[inline(always)]
+    pub fn rotate(self, v: V3<T>) -> V3<T> {
+        let u = V3 {
+            x: self.x,
+            y: self.y,
+            z: self.z,
+        };
+        let uv = u.cross(v);
+        let uuv = u.cross(uv);
+        v + (uv.scale(self.w) + uuv).scale(T::splat(2.0))
+    }
+    /// Renormalised with the backend's square root; identity where the norm is zero or not
+    /// finite (as `math::quat_normalize`).
+    #[inline(always)]
+    pub fn normalize<M: Math>(self) -> Self {
+        let n2 = self.x * self.x + self.y * self.y + self.z * self.z + self.w * self.w;
+        let ok = T::splat(0.0).lt(n2) & n2.finite();
+        let inv = T::splat(1.0) / n2.sqrt::<M>();
+        Q {
+            x: T::select(ok, self.x * inv, T::splat(0.0)),
+            y: T::select(ok, self.y * inv, T::splat(0.0)),
+            z: T::select(ok, self.z * inv, T::splat(0.0)),
+            w: T::select(ok, self.w * inv, T::splat(1.0)),
+        }
+    }
+    /// The minimal rotation from unit `a` to unit `b`, not normalised:
+    /// `(a × b, 1 + a·b)` (as `math::quat_between_unnormalized`).
+    #[inline(always)]
+    pub fn between_unnormalized(a: V3<T>, b: V3<T>) -> Self {
+        let c = a.cross(b);
+        Q {
+            x: c.x,
+            y: c.y,
+            z: c.z,
+            w: T::splat(1.0) + a.dot(b),
+        }
+    }
+    /// Per lane `if mask { a } else { b }`.
+    #[inline(always)]
+    pub fn select(mask: T::Mask, a: Self, b: Self) -> Self {
+        Q {
+            x: T::select(mask, a.x, b.x),
+            y: T::select(mask, a.y, b.y),
+            z: T::select(mask, a.z, b.z),
+            w: T::select(mask, a.w, b.w),
+        }
+    }
+}
+
+impl From<Quat> for Q<Real> {
+    #[inline(always)]
+    fn from(q: Quat) -> Self {
+        Q {
+            x: q.x,
+            y: q.y,
+            z: q.z,
+            w: q.w,
+        }
+    }
+}
+
+impl From<Q<Real>> for Quat {
+    #[inline(always)]
+    fn from(q: Q<Real>) -> Self {
+        Quat::from_xyzw(q.x, q.y, q.z, q.w)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{self, Libm};
+
+    #[test]
+    fn lanes_match_the_scalar_helpers_bit_for_bit() {
+        let q = math::quat_from_axis_angle::<Libm>(Vec3::new(0.0, 0.6, 0.8), 1.1);
+        let v = Vec3::new(0.3, -1.2, 2.0);
+        let r: Vec3 = Q::<Real>::from(q).rotate(v.into()).into();
+        assert_eq!(r, math::rotate(q, v));
+        let p: Quat = Q::<Real>::from(q)
+            .product(q.into())
+            .normalize::<Libm>()
+            .into();
+        assert_eq!(p, math::quat_normalize::<Libm>(math::quat_mul(q, q)));
+        let wide = Q::<Wide<4>>::splat(q).rotate(V3::splat(v));
+        assert_eq!(wide.y.0, [r.y; 4]);
+        let m = Wide([1.0, -1.0, 2.0, 0.0]).lt(Wide::splat(0.5));
+        assert_eq!(m.0, [false, true, false, true]);
+    }
+}
