@@ -749,3 +749,51 @@ fn builtin_errors_name_the_builtin() {
         "builtin:firmware: dt: 1 is out of range, allowed 0.00001 to 0.02 s"
     );
 }
+
+/// The documented example with each line dropped, cut short at many places, or with a number
+/// replaced by an extreme: a scene or one placed error every time, never a panic.
+#[test]
+fn mangled_scenes_give_errors_not_panics() {
+    let doc = include_str!("../../../docs/scene-format.md");
+    let start = doc.find("```toml\n").unwrap() + "```toml\n".len();
+    let example = &doc[start..start + doc[start..].find("```").unwrap()];
+    let lines: Vec<&str> = example.lines().collect();
+    let mut variants: Vec<String> = Vec::new();
+    for i in 0..lines.len() {
+        let mut kept = lines.clone();
+        kept.remove(i);
+        variants.push(kept.join("\n"));
+        for extreme in ["-1e39", "0", "1e-45", "nan", "-7", "\"x\"", "[]"] {
+            if let Some(eq) = lines[i].find(" = ") {
+                let mut changed = lines.clone();
+                let replaced = format!("{} = {extreme}", &lines[i][..eq]);
+                changed[i] = &replaced;
+                variants.push(changed.join("\n"));
+            }
+        }
+    }
+    for cut in (0..example.len()).step_by(41) {
+        if example.is_char_boundary(cut) {
+            variants.push(example[..cut].to_string());
+        }
+    }
+    let mut refused = 0;
+    for text in &variants {
+        match Scene::parse_and_prepare(text, "t.toml", Path::new(".")) {
+            Ok((scene, _)) => {
+                assert_eq!(Scene::from_toml(&scene.to_toml(), "again").unwrap(), scene);
+            }
+            Err(e) => {
+                refused += 1;
+                let line = e.to_string();
+                assert!(line.starts_with("t.toml:"), "{line}");
+                assert!(!line.contains('\n'), "{line}");
+            }
+        }
+    }
+    assert!(
+        refused > variants.len() / 2,
+        "{refused} of {}",
+        variants.len()
+    );
+}
