@@ -534,8 +534,8 @@ pub struct OutputSpec {
 }
 
 impl Scene {
-    /// Parses scene-file text. `file` names the text in error messages; `base` is the folder
-    /// relative paths in the scene (hair files) are taken from.
+    /// Parses scene-file text (no checks beyond the format's types and fields). `file` names
+    /// the text in error messages.
     pub fn from_toml(text: &str, file: &str) -> Result<Scene, SceneError> {
         let index = spans::SpanIndex::parse(text).map_err(|e| error::from_toml(file, text, &e))?;
         let scene: Scene = toml::from_str(text).map_err(|e| index.serde_error(file, text, &e))?;
