@@ -134,7 +134,6 @@ pub struct DftlCoefficients {
 /// `a(t) = direction · strength · (1 + gust · n(t))`, with `n` a seeded, smooth value noise of
 /// time in `[−1, 1]` (see `forces::wind_acceleration`).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct WindParams {
     /// Unit direction the wind blows towards (world frame). Default +x.
     pub direction: Vec3,
@@ -146,6 +145,21 @@ pub struct WindParams {
     pub gust_frequency: Real,
     /// Seed of the gust noise: same seed, same gusts on every target.
     pub seed: u32,
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for WindParams {
+    fn format(&self, f: defmt::Formatter) {
+        defmt::write!(
+            f,
+            "WindParams {{ direction: {}, strength: {}, gust: {}, gust_frequency: {}, seed: {} }}",
+            crate::math::DefmtVec3(self.direction),
+            self.strength,
+            self.gust,
+            self.gust_frequency,
+            self.seed
+        )
+    }
 }
 
 /// Everything a world needs to know besides its strands, colliders and grabs.

@@ -6,6 +6,8 @@
 #![no_std]
 #![no_main]
 
+mod latency;
+
 use core::cell::RefCell;
 
 use cortex_m::interrupt::Mutex;
@@ -20,7 +22,7 @@ use hairsim_core::{Libm, Math, Real, World};
 /// IEEE 754 requires `squareRoot` to be correctly rounded, and so is `libm::sqrtf`: the two give
 /// the same bits, `VSQRT` in 14 cycles instead of a software routine.
 #[derive(Clone, Copy, Default)]
-struct Vsqrt;
+pub struct Vsqrt;
 
 impl Math for Vsqrt {
     const NAME: &'static str = "vsqrt+libm";
@@ -75,6 +77,12 @@ fn main() -> ! {
             rod
         }
     });
+    if code == debug::EXIT_SUCCESS {
+        if let Some(mut peripherals) = cortex_m::Peripherals::take() {
+            latency::start(&mut peripherals.SYST);
+            latency::run();
+        }
+    }
     debug::exit(code);
     #[allow(clippy::empty_loop)]
     loop {}

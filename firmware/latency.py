@@ -1,0 +1,71 @@
+#!/usr/bin/env python3
+"""Turns the firmware's `latency …` lines (SysTick ticks per step under QEMU -icount shift=0)
+into instructions and a Cortex-M4F cycle estimate, and names the largest rod and DFTL scenes
+that fit half of a 1 ms tick on a 168 MHz part.
+
+Model (stated, not measured on silicon): QEMU's icount makes each instruction 1 ns and SysTick
+counts the 25 MHz system clock, so one tick is 40 instructions. On a Cortex-M4F most
+instructions take 1 cycle; VDIV.F32 and VSQRT.F32 take 14, VFMA 3. Their share of the step's
+instructions is taken from the disassembly of the firmware image (a static share standing in
+for the dynamic one):  cycles = instructions × (1 + 13·share(VDIV, VSQRT) + 2·share(VFMA)).
+
+Usage: latency.py FIRMWARE_LOG FIRMWARE_ELF
+"""
+import re
+import subprocess
+import sys
+
+INSTRUCTIONS_PER_TICK = 40
+CLOCK_HZ = 168e6
+BUDGET_CYCLES = 0.5e-3 * CLOCK_HZ
+
+
+def shares(elf):
+    out = subprocess.run(["llvm-objdump", "-d", "--no-show-raw-insn", elf],
+                         check=True, capture_output=True, text=True).stdout
+    total = divsqrt = fma = 0
+    for line in out.splitlines():
+        m = re.match(r"\s+[0-9a-f]+:\s+(\S+)", line)
+        if not m:
+            continue
+        total += 1
+        op = m.group(1)
+        if op.startswith(("vdiv", "vsqrt")):
+            divsqrt += 1
+        elif op.startswith(("vfma", "vfms", "vfnma", "vfnms")):
+            fma += 1
+    return total, divsqrt / total, fma / total
+
+
+def main():
+    log, elf = sys.argv[1], sys.argv[2]
+    total, s_divsqrt, s_fma = shares(elf)
+    factor = 1 + 13 * s_divsqrt + 2 * s_fma
+    print(f"disassembly: {total} instructions, VDIV/VSQRT {100 * s_divsqrt:.2f} %, "
+          f"VFMA {100 * s_fma:.2f} % -> {factor:.3f} cycles per instruction")
+    print("| solver | nodes | calm min / median / max (k instr) | violent min / median / max (k instr) "
+          "| violent max / calm median | est. µs at 168 MHz (violent max) | fits 0.5 ms |")
+    print("|---|---|---|---|---|---|---|")
+    best = {}
+    for line in open(log):
+        m = re.match(r"latency (\w+) strands (\d+) nodes (\d+) calm (\d+) (\d+) (\d+) "
+                     r"violent (\d+) (\d+) (\d+)", line)
+        if not m:
+            continue
+        solver, nodes = m.group(1), int(m.group(3))
+        calm = [int(m.group(i)) * INSTRUCTIONS_PER_TICK for i in (4, 5, 6)]
+        violent = [int(m.group(i)) * INSTRUCTIONS_PER_TICK for i in (7, 8, 9)]
+        cycles = violent[2] * factor
+        fits = cycles <= BUDGET_CYCLES
+        if fits:
+            best[solver] = max(best.get(solver, 0), nodes)
+        k = lambda v: "/".join(f"{x / 1000:.1f}" for x in v)
+        print(f"| {solver} | {nodes} | {k(calm)} | {k(violent)} | "
+              f"{violent[2] / calm[1]:.3f} | {cycles / CLOCK_HZ * 1e6:.0f} | {'yes' if fits else 'no'} |")
+    for solver in ("rod", "dftl"):
+        print(f"largest {solver} scene within half a 1 ms tick at 168 MHz: "
+              f"{best.get(solver, 0) or 'none of those measured'} nodes")
+
+
+if __name__ == "__main__":
+    main()

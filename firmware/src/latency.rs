@@ -1,0 +1,180 @@
+//! Bounded latency, measured on the target: SysTick ticks per step of rod and DFTL scenes of
+//! growing size, calm (head still, hair hanging) and violent (head shaking at 10 rad/s, hair
+//! starting horizontal), in fixed-cost mode.
+//!
+//! Under `qemu-system-arm -icount shift=0` every instruction takes 1 ns of virtual time and
+//! SysTick counts the 25 MHz system clock, so one tick is 40 instructions: a deterministic
+//! count. `firmware/latency.py` turns the printed ticks into instructions and a Cortex-M4F
+//! cycle estimate.
+
+use cortex_m::peripheral::{syst::SystClkSource, SYST};
+use cortex_m_semihosting::hprintln;
+use hairsim_core::{
+    Collider, Effect, Effects, Math, Mode, Params, Pose, Real, Shake, Shape, Solver, StepInput,
+    Strand, Vec3, World,
+};
+
+/// Steps measured per scene.
+const STEPS: usize = 200;
+
+/// Per-step tick counts of the scene being measured.
+static mut TICKS: [u32; STEPS] = [0; STEPS];
+
+/// Starts SysTick free-running on the core clock.
+pub fn start(syst: &mut SYST) {
+    syst.set_clock_source(SystClkSource::Core);
+    syst.set_reload(0x00FF_FFFF);
+    syst.clear_current();
+    syst.enable_counter();
+}
+
+/// Ticks `f` takes (SysTick counts down; 24 bits).
+fn ticks(f: impl FnOnce()) -> u32 {
+    let before = SYST::get_current();
+    f();
+    let after = SYST::get_current();
+    before.wrapping_sub(after) & 0x00FF_FFFF
+}
+
+/// Minimum, median and maximum of `t` (sorted in place).
+fn stats(t: &mut [u32]) -> (u32, u32, u32) {
+    t.sort_unstable();
+    (t[0], t[t.len() / 2], t[t.len() - 1])
+}
+
+fn params(solver: Solver) -> Params {
+    let effects = match solver {
+        Solver::Rod => Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Drag,
+            Effect::Bending,
+            Effect::Twist,
+            Effect::Inextensibility,
+            Effect::Collisions,
+        ]),
+        Solver::Dftl => Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Drag,
+            Effect::Inextensibility,
+            Effect::Collisions,
+            Effect::Shape,
+        ]),
+    };
+    Params {
+        solver,
+        effects,
+        mode: Mode::FixedCost,
+        drag: 2.0e-7,
+        ..Params::DEFAULT
+    }
+}
+
+/// Fills `world` with `strands` strands of `nodes` nodes (1 cm segments) rooted around a 5 cm
+/// head: hanging down (calm) or sticking out horizontally (violent).
+fn build<const S: usize, const N: usize, M: Math>(
+    world: &mut World<S, N, M>,
+    solver: Solver,
+    strands: usize,
+    nodes: usize,
+    violent: bool,
+) -> bool {
+    let mut ok = world.configure(params(solver)).is_ok();
+    ok &= world
+        .add_collider(Collider {
+            shape: Shape::Sphere {
+                centre: Vec3::ZERO,
+                radius: 0.05,
+            },
+            attached_to_head: true,
+        })
+        .is_ok();
+    for s in 0..strands {
+        let (sin, cos) = M::sin_cos(s as Real * 2.399_963);
+        let out = Vec3::new(cos, 0.0, sin);
+        let root = out * 0.05;
+        let direction = if violent { out } else { -Vec3::Y };
+        let mut points = [Vec3::ZERO; N];
+        for (i, p) in points.iter_mut().enumerate().take(nodes) {
+            *p = root + direction * (0.01 * i as Real) + out * (0.0001 * i as Real);
+        }
+        match Strand::<N>::from_polyline(&points[..nodes], &hairsim_core::Material::HUMAN_HAIR) {
+            Ok(strand) => ok &= world.add_strand(strand).is_ok(),
+            Err(_) => ok = false,
+        }
+    }
+    ok
+}
+
+/// Measures one scene and prints a line: solver, nodes, calm and violent min/median/max ticks.
+fn measure<const S: usize, const N: usize, M: Math>(
+    world: &mut World<S, N, M>,
+    solver: Solver,
+    strands: usize,
+    nodes: usize,
+) {
+    let mut line = [(0u32, 0u32, 0u32); 2];
+    for (v, violent) in [false, true].into_iter().enumerate() {
+        *world = World::new();
+        if !build(world, solver, strands, nodes, violent) {
+            hprintln!(
+                "latency error: cannot build {} strands of {} nodes",
+                strands,
+                nodes
+            );
+            return;
+        }
+        // SAFETY: the only access to TICKS: single-threaded, no interrupt touches it.
+        let t = unsafe { &mut *core::ptr::addr_of_mut!(TICKS) };
+        for (k, slot) in t.iter_mut().enumerate() {
+            let time = (k + 1) as Real * world.params().dt;
+            let head = if violent {
+                Shake::TEN_RAD_PER_S.pose_at::<M>(time)
+            } else {
+                Pose::IDENTITY
+            };
+            let input = StepInput {
+                head,
+                accelerations: None,
+            };
+            *slot = ticks(|| {
+                world.step(&input);
+            });
+        }
+        line[v] = stats(t);
+    }
+    let name = match solver {
+        Solver::Rod => "rod",
+        Solver::Dftl => "dftl",
+    };
+    hprintln!(
+        "latency {} strands {} nodes {} calm {} {} {} violent {} {} {}",
+        name,
+        strands,
+        strands * nodes,
+        line[0].0,
+        line[0].1,
+        line[0].2,
+        line[1].0,
+        line[1].1,
+        line[1].2
+    );
+}
+
+type RodWorld<M> = World<8, 32, M>;
+type DftlWorld<M> = World<64, 16, M>;
+
+static mut ROD: RodWorld<crate::Vsqrt> = World::new();
+static mut DFTL: DftlWorld<crate::Vsqrt> = World::new();
+
+/// Runs every measurement: rod 32–256 nodes, DFTL 64–1024 vertices.
+pub fn run() {
+    // SAFETY: called once from `main`, nothing else touches these statics.
+    let rod = unsafe { &mut *core::ptr::addr_of_mut!(ROD) };
+    for strands in [1, 2, 4, 8] {
+        measure(rod, Solver::Rod, strands, 32);
+    }
+    let dftl = unsafe { &mut *core::ptr::addr_of_mut!(DFTL) };
+    for strands in [4, 8, 16, 32, 64] {
+        measure(dftl, Solver::Dftl, strands, 16);
+    }
+}
