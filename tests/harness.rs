@@ -479,3 +479,32 @@ fn the_haptic_scene_reports_its_grab_force() {
     assert!(forces[0].iter().any(|f| *f != 0.0), "{forces:?}");
     assert_eq!(summary.grab_status.unwrap(), vec!["held".to_string()]);
 }
+
+/// `[material] tip_stiffness` reaches the rod's bending forces: a softer tip changes the run.
+#[test]
+fn a_fading_bending_stiffness_reaches_the_rod() {
+    let mut scene = hairsim::builtin::firmware_scene();
+    let go = |scene: &Scene| {
+        let loaded = hairsim::run::Loaded {
+            source: "fade".into(),
+            scene: scene.clone(),
+            prepared: scene.prepare().unwrap(),
+        };
+        run(
+            &loaded,
+            &RunOptions {
+                steps: Some(200),
+                ..RunOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let uniform = go(&scene);
+    scene.material = Some(hairsim::scene::MaterialSpec {
+        tip_stiffness: Some(0.2),
+        ..Default::default()
+    });
+    let faded = go(&scene);
+    assert!(faded.finite);
+    assert_ne!(uniform.state_hash, faded.state_hash);
+}

@@ -217,7 +217,10 @@ impl<const N: usize, M: Math> Sim<N, M> {
     }
 }
 
-/// Bending stiffness fading linearly from the root's to `tip` times it at the last segment.
+/// Bending stiffness fading linearly from the root's to `tip` (≤ 1) times it at the last
+/// segment, in the rest data both solvers' stages read (`rest.bending_stiffness` and the rod's
+/// `rest.rod.bending_stiffness`). Only ever lowered, so the rod's stable time step (computed
+/// from the root's, the stiffest) stays valid.
 fn fade_bending<const N: usize>(strand: &mut Strand<N>, tip: Real) {
     if tip == 1.0 {
         return;
@@ -225,7 +228,9 @@ fn fade_bending<const N: usize>(strand: &mut Strand<N>, tip: Real) {
     let segments = strand.nodes() - 1;
     for j in 0..segments {
         let s = j as Real / (segments.max(2) - 1) as Real;
-        strand.rest.bending_stiffness[j] *= 1.0 - s + s * tip;
+        let factor = 1.0 - s + s * tip;
+        strand.rest.bending_stiffness[j] *= factor;
+        strand.rest.rod.bending_stiffness[j] *= factor;
     }
 }
 

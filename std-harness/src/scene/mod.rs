@@ -119,8 +119,8 @@ pub struct MaterialSpec {
     /// µ ≥ 1.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub minor_axis_penalty: Option<f32>,
-    /// Bending stiffness at the tip as a fraction of the root's, fading linearly along the
-    /// strand (default 1: uniform).
+    /// Bending stiffness at the tip as a fraction of the root's (0 to 1), fading linearly
+    /// along the strand (default 1: uniform).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tip_stiffness: Option<f32>,
 }

@@ -225,7 +225,7 @@ fn material_rod_and_dftl_errors() {
     refused(
         &[],
         "[material]\ntip_stiffness = -0.5\n",
-        "t.toml:13: material.tip_stiffness: -0.5 is out of range, allowed 0 to 10",
+        "t.toml:13: material.tip_stiffness: -0.5 is out of range, allowed 0 to 1",
     );
     refused(
         &[],

@@ -305,7 +305,7 @@ pub fn material(prefix: &str, m: &MaterialSpec) -> Check {
             &f("tip_stiffness"),
             v,
             0.0,
-            10.0,
+            1.0,
             " (fraction of the root's)",
         )?;
     }
