@@ -106,10 +106,14 @@ fn measure(label: &str, vertices: usize, steps: u32, mut run: impl FnMut()) {
     );
 }
 
-fn size<const N: usize>(count: usize) {
+fn size<const N: usize>(count: usize, quick: bool) {
     let vertices = count * N;
-    // About 20 M vertex-steps per run.
-    let steps = (20_000_000 / vertices).max(10) as u32;
+    // About 20 M vertex-steps per run; one step each under `cargo test --benches`.
+    let steps = if quick {
+        1
+    } else {
+        (20_000_000 / vertices).max(10) as u32
+    };
     for shape in [false, true] {
         let ctx = contexts(shape, steps);
         let name = if shape { "dftl+shape" } else { "dftl" };
@@ -179,9 +183,12 @@ fn main() {
     if std::env::args().any(|a| a == "--list") {
         return;
     }
-    size::<8>(1024);
-    size::<32>(1024);
-    size::<32>(4096);
-    size::<64>(4096);
-    size::<64>(16384);
+    // `cargo bench` passes `--bench`; `cargo test --benches` does not: then every case runs
+    // once, as a test that the benchmark works, not a measurement.
+    let quick = !std::env::args().any(|a| a == "--bench");
+    size::<8>(1024, quick);
+    size::<32>(1024, quick);
+    size::<32>(4096, quick);
+    size::<64>(4096, quick);
+    size::<64>(16384, quick);
 }
