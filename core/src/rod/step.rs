@@ -5,11 +5,18 @@
 //! Symplectic Euler on the bending forces is stable for `dt ≤ dt_max = (h²/2)·√(ρA/(max(1,µ)α))`
 //! (DESIGN.md "Stability"; [`RodRest::stable_time_step`](super::energy::RodRest)). Human hair
 //! at 1 cm segments sits at 60–90 % of it at 1 ms, so stiffer hair (or µ > 1) would chatter. The
-//! remedy chosen here is the simplest one whose cost does not depend on the state: stages (1)
-//! and (2) run `k = ⌈dt / (SAFETY · dt_max)⌉` times with `dt / k` ([`substeps`]), `k` fixed per
-//! strand by its rest data and `dt` — so a firmware step's cost is known when the scene is
-//! built. `θ` is held over the substeps (the twist is quasistatic and solved once per step);
-//! the projection and the twist run once per step.
+//! remedy chosen here is substepping: stages (1) and (2) run
+//! `k = ⌈dt · (2/g) / (SAFETY · dt_max)⌉` times with `dt / k` ([`substeps_for_shape`]), where
+//! `g = min_i d_i / (|ê^{i−1}||ê^i|)` is the smallest relative binormal denominator of the
+//! shape the step starts from (2 when straight). The bending stiffness of the discrete rod is
+//! not the rest stiffness: `(κb)_i = 2 tan(φ_i/2)` makes the Hessian grow like `1/d_i²`, so a
+//! strand bent hard (a shaking head folds strands at the root to `φ ≈ 2 rad`, `g ≈ 0.5`) has a
+//! 4× shorter limit. A count from rest data alone ([`substeps`], the count at `g = 2`) let the
+//! firmware scene's stiffest mode run at 3× its limit after 600 steps and blow up. The count
+//! therefore depends on the state, bounded by [`MAX_SUBSTEPS`]: in fixed-cost mode a step's
+//! worst-case cost is `MAX_SUBSTEPS` force evaluations, reached only near a fold; a healthy
+//! human-hair scene stays at 1–4. `θ` is held over the substeps (the twist is quasistatic and
+//! solved once per step); the projection and the twist run once per step.
 //!
 //! Cost: `k` evaluations of the frames and forces (O(n) each; one square root per segment and
 //! no trigonometry — the material angles' sines and cosines are computed once per step and
@@ -130,19 +137,79 @@ fn strand_frames<M: Math, const N: usize>(strand: &Strand<N>) -> RodFrames<M, N>
     )
 }
 
-/// Substeps per step for this strand: `⌈dt / (SAFETY · dt_max)⌉`, at least 1, at most
-/// [`MAX_SUBSTEPS`]. Depends only on rest data and `dt`, so it is the same every step.
+/// Substeps per step for this strand *at rest*: `⌈dt / (SAFETY · dt_max)⌉`, at least 1, at
+/// most [`MAX_SUBSTEPS`]. Depends only on rest data and `dt`. The step itself uses
+/// [`substeps_for_shape`], which also sees the current turning angles.
 #[must_use]
 pub fn substeps<const N: usize>(rest: &RodRest<N>, dt: Real, bending: bool) -> u32 {
-    if !bending {
+    substeps_at_stiffness(rest, dt, bending, 1.0)
+}
+
+/// Smallest `d_i / (|ê^{i−1}||ê^i|)` over the interior nodes of `frames`, with
+/// `d_i = |ê^{i−1}||ê^i| + e^{i−1}·e^i` the curvature binormal's denominator: `1 + cos φ_i`
+/// for a turning angle `φ_i` at rest lengths, 2 for a straight node, 0 at a fold. `2` when
+/// the strand has no interior node.
+#[must_use]
+pub fn smallest_binormal_denominator<M: Math, const N: usize>(
+    frames: &RodFrames<M, N>,
+    rest_length: &[Real; N],
+) -> Real {
+    let mut smallest: Real = 2.0;
+    let n = frames.interior().min(N.saturating_sub(1));
+    for i in 1..=n {
+        let scale = rest_length[i - 1] * rest_length[i];
+        let relative = frames.denominator[i] / scale;
+        // A NaN counts as a fold (the guard rolls the strand back after the step).
+        if relative < smallest || relative.is_nan() {
+            smallest = relative;
+        }
+    }
+    smallest
+}
+
+/// Substeps for the strand's *current* shape: the bending stiffness of the discrete rod grows
+/// with the turning angle. `(κb)_i = 2 tan(φ_i/2) b̂` has `∇(κb)_i ∝ 1/d_i`
+/// (DESIGN.md "Kirchhoff rod step"), so the Hessian of `E_bend` grows like `1/d_i²` and the
+/// explicit limit shrinks like `d_i`: with `g = min_i d_i/(|ê^{i−1}||ê^i|)` (2 when straight,
+/// [`smallest_binormal_denominator`]), `dt_max(x) = dt_max · g/2`. A strand swung hard at the
+/// root reaches `φ ≈ 2 rad` (`g ≈ 0.5`, 4× shorter limit; the eigenvalues of `M⁻¹K` measured
+/// on the firmware scene follow this within a factor 1.4), so a count from rest data alone
+/// lets the stiffest mode run past the limit and chatter, which folds the strand further
+/// (positive feedback). Near a fold (`g → 0`) the count reaches the cap [`MAX_SUBSTEPS`].
+#[must_use]
+pub fn substeps_for_shape<const N: usize>(
+    rest: &RodRest<N>,
+    dt: Real,
+    bending: bool,
+    smallest_denominator: Real,
+) -> u32 {
+    // A non-positive or NaN denominator (a fold) takes the cap.
+    let stiffening = if smallest_denominator > 0.0 {
+        2.0 / smallest_denominator.min(2.0)
+    } else {
+        Real::INFINITY
+    };
+    substeps_at_stiffness(rest, dt, bending, stiffening)
+}
+
+/// `⌈dt · stiffening / (SAFETY · dt_max)⌉` clamped to `1 ..= MAX_SUBSTEPS`; `stiffening ≥ 1`
+/// divides the rest limit `dt_max`.
+fn substeps_at_stiffness<const N: usize>(
+    rest: &RodRest<N>,
+    dt: Real,
+    bending: bool,
+    stiffening: Real,
+) -> u32 {
+    if !bending || !rest.stable_time_step.is_finite() {
         return 1;
     }
-    let ratio = dt / (SAFETY * rest.stable_time_step);
+    let ratio = dt * stiffening / (SAFETY * rest.stable_time_step);
     if ratio <= 1.0 {
         1
     } else if ratio < MAX_SUBSTEPS as Real {
         libm::ceilf(ratio) as u32
     } else {
+        // Also a NaN ratio: the most work, never an out-of-range cast.
         MAX_SUBSTEPS
     }
 }
@@ -159,7 +226,16 @@ fn forces_and_integrate<M: Math, const N: usize>(
     report: &mut StepReport,
 ) {
     let elastic = terms.bending || terms.twist;
-    let k = substeps(&strand.rest.rod, ctx.dt, terms.bending);
+    // The frames of the shape the step starts from: they set the substep count and serve the
+    // first substep's forces.
+    let mut frames = elastic.then(|| strand_frames::<M, N>(strand));
+    let k = match &frames {
+        Some(frames) if terms.bending => {
+            let smallest = smallest_binormal_denominator(frames, &strand.rest.rod.rest_length);
+            substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest)
+        }
+        _ => 1,
+    };
     let h = ctx.dt / k as Real;
     let mut forces = [Vec3::ZERO; N];
     let segments = strand.rest.nodes.saturating_sub(1).min(N);
@@ -174,7 +250,9 @@ fn forces_and_integrate<M: Math, const N: usize>(
     report.ran(Stage::Integrate);
     for _ in 0..k {
         if elastic {
-            let frames = strand_frames::<M, N>(strand);
+            let frames = frames
+                .take()
+                .unwrap_or_else(|| strand_frames::<M, N>(strand));
             elastic_forces_with_angles(
                 &frames,
                 &strand.state.theta,

@@ -140,6 +140,57 @@ fn substeps_follow_the_stability_bound() {
     assert_eq!(counts, [1, 3, 10, 30]);
 }
 
+#[test]
+fn substeps_grow_as_the_binormal_denominator_shrinks() {
+    let s = Strand::<NODES>::from_polyline(&polyline(0, 20)[..20], &Material::HUMAN_HAIR).unwrap();
+    let rest = &s.rest.rod;
+    let dt = 0.004;
+    let ratio = dt / (SAFETY * rest.stable_time_step);
+    // Straight (g = 2): the rest count; g = 0.5 (φ = 2.09 rad): 4× the work; a fold (g ≤ 0
+    // or NaN): the cap; bending off: 1.
+    assert_eq!(
+        substeps_for_shape(rest, dt, true, 2.0),
+        substeps(rest, dt, true)
+    );
+    assert_eq!(
+        substeps_for_shape(rest, dt, true, 2.5),
+        substeps(rest, dt, true)
+    );
+    assert_eq!(
+        substeps_for_shape(rest, dt, true, 0.5),
+        libm::ceilf(4.0 * ratio) as u32
+    );
+    let mut previous = 0;
+    for g in [2.0, 1.5, 1.0, 0.5, 0.25, 0.1, 0.01] {
+        let k = substeps_for_shape(rest, dt, true, g);
+        assert!(
+            k >= previous && k <= MAX_SUBSTEPS,
+            "g {g}: {k} after {previous}"
+        );
+        previous = k;
+    }
+    assert_eq!(substeps_for_shape(rest, dt, true, 0.0), MAX_SUBSTEPS);
+    assert_eq!(substeps_for_shape(rest, dt, true, -0.3), MAX_SUBSTEPS);
+    assert_eq!(substeps_for_shape(rest, dt, true, Real::NAN), MAX_SUBSTEPS);
+    assert_eq!(substeps_for_shape(rest, dt, false, 0.0), 1);
+}
+
+#[test]
+fn smallest_binormal_denominator_is_one_plus_cos_of_the_sharpest_turn() {
+    // Three segments at rest length, turning by 0.3 rad then 1.9 rad.
+    let mut points = [Vec3::ZERO; NODES];
+    let mut direction: Real = 0.0;
+    for (i, turn) in [0.0, 0.3, 1.9].iter().enumerate() {
+        direction += turn;
+        let (sin, cos) = libm::sincosf(direction);
+        points[i + 1] = points[i] + Vec3::new(cos, sin, 0.0) * 0.01;
+    }
+    let s = Strand::<NODES>::from_polyline(&points[..4], &Material::HUMAN_HAIR).unwrap();
+    let frames = strand_frames::<Libm, NODES>(&s);
+    let g = smallest_binormal_denominator(&frames, &s.rest.rod.rest_length);
+    assert!((g - (1.0 + libm::cosf(1.9))).abs() < 1e-5, "{g}");
+}
+
 /// Test-only stand-in for the projection: Gauss–Seidel on the segment lengths (nodes 0 and 1
 /// fixed), then `v += Δx / h`.
 fn restore_lengths(strand: &mut Strand<NODES>, dt: Real) {
