@@ -93,39 +93,36 @@ fn run(world: &mut FirmwareWorld) -> debug::ExitStatus {
         hprintln!("error: VSQRT and libm::sqrtf disagree");
         return debug::EXIT_FAILURE;
     }
-    match firmware::run(world, firmware::STEPS) {
-        Ok(hash) => {
-            let finite = world.strands().iter().all(|s| s.is_finite());
-            hprintln!(
-                "scene firmware steps {} strands {} finite {} grab {:?} state_hash 0x{:016x}",
-                world.steps(),
-                world.strands().len(),
-                finite,
-                world.grabs().first().map(|g| g.status),
-                hash
-            );
-            if finite {
-                debug::EXIT_SUCCESS
-            } else {
-                debug::EXIT_FAILURE
-            }
-        }
-        Err(e) => {
-            hprintln!("error: building the firmware scene: {}", e);
-            debug::EXIT_FAILURE
-        }
-    }
+    let result = firmware::run(world, firmware::STEPS);
+    print_result("firmware", world, result)
 }
 
 fn run_dftl(world: &mut DftlWorld) -> debug::ExitStatus {
-    match firmware_dftl::run(world, firmware_dftl::STEPS) {
+    let result = firmware_dftl::run(world, firmware_dftl::STEPS);
+    print_result("firmware-dftl", world, result)
+}
+
+/// Prints `scene NAME steps … state_hash 0x…` (the line CI compares with the host) and says
+/// whether the run succeeded: built, and finite at the end.
+fn print_result<const S: usize, const N: usize>(
+    name: &str,
+    world: &World<S, N, Vsqrt>,
+    result: Result<u64, hairsim_core::Error>,
+) -> debug::ExitStatus {
+    match result {
         Ok(hash) => {
             let finite = world.strands().iter().all(|s| s.is_finite());
             hprintln!(
-                "scene firmware-dftl steps {} strands {} finite {} state_hash 0x{:016x}",
+                "scene {} steps {} strands {} finite {} grabs held {} state_hash 0x{:016x}",
+                name,
                 world.steps(),
                 world.strands().len(),
                 finite,
+                world
+                    .grabs()
+                    .iter()
+                    .filter(|g| g.status == hairsim_core::GrabStatus::Held)
+                    .count(),
                 hash
             );
             if finite {
@@ -135,7 +132,7 @@ fn run_dftl(world: &mut DftlWorld) -> debug::ExitStatus {
             }
         }
         Err(e) => {
-            hprintln!("error: building the firmware-dftl scene: {}", e);
+            hprintln!("error: building the {} scene: {}", name, e);
             debug::EXIT_FAILURE
         }
     }
