@@ -34,7 +34,7 @@ pub struct HairArgs {
 pub enum Command {
     /// Run a scene and print a summary with the state hash.
     #[command(
-        after_help = "Examples:\n  hairsim run\n  hairsim run head-1 --steps 500 --json --threads 2\n  hairsim run scenes/one-hair.toml --record one.rec\n  hairsim run strands.hair --scale 0.01 --up z"
+        after_help = "Examples:\n  hairsim run\n  hairsim run head-1 --steps 500 --json --threads 2\n  hairsim run head-2 --steps 600 --out out --gif\n  hairsim run scenes/one-hair.toml --record one.rec\n  hairsim run strands.hair --scale 0.01 --up z"
     )]
     Run {
         /// A built-in scene name (see `hairsim scenes`), a TOML scene file, or a .hair/.tfx
@@ -49,11 +49,16 @@ pub enum Command {
         /// Write frames and pictures into this folder.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// With --out: also write DIR/run.gif, an animation of the run (as the scene's
+        /// `[output] picture = "gif"`).
+        #[arg(long, requires = "out")]
+        gif: bool,
         /// Record the inputs and state hashes for `hairsim replay`.
         #[arg(long)]
         record: Option<PathBuf>,
-        /// Threads stepping strand blocks (the result is the same bits for any count).
-        #[arg(long, default_value_t = 1)]
+        /// Threads stepping strand blocks (the result is the same bits for any count); all
+        /// cores by default.
+        #[arg(long, default_value_t = all_cores())]
         threads: usize,
         /// With --out: a frame every K steps; with --record: a state hash every K steps (default 10).
         #[arg(long, value_name = "K")]
@@ -92,6 +97,11 @@ pub enum Command {
     },
 }
 
+/// The machine's cores (1 if it cannot tell).
+fn all_cores() -> usize {
+    std::thread::available_parallelism().map_or(1, usize::from)
+}
+
 impl HairArgs {
     /// As the run module takes them.
     #[must_use]
@@ -111,6 +121,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<String> {
             steps,
             json,
             out,
+            gif,
             record,
             threads,
             every,
@@ -120,6 +131,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<String> {
             steps,
             json,
             out,
+            gif,
             record,
             threads,
             every,

@@ -18,6 +18,8 @@ pub struct Args {
     pub json: bool,
     /// `--out`.
     pub out: Option<PathBuf>,
+    /// `--gif`: also an animation of the run into `--out`.
+    pub gif: bool,
     /// `--record`.
     pub record: Option<PathBuf>,
     /// `--threads`.
@@ -31,7 +33,10 @@ pub struct Args {
 /// Runs the scene; the summary as text or JSON.
 pub fn run(args: &Args) -> Result<String> {
     let spec = args.scene.as_deref().unwrap_or(DEFAULT_SCENE);
-    let loaded = load(spec, &args.hair)?;
+    let mut loaded = load(spec, &args.hair)?;
+    if args.gif {
+        loaded.prepared.output.picture = "gif".into();
+    }
     let summary = run_scene(
         &loaded,
         &RunOptions {
