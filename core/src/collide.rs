@@ -151,16 +151,7 @@ impl Shape {
     pub fn penetration<M: Math>(&self, p: Vec3) -> Option<Contact> {
         match *self {
             Shape::Sphere { centre, radius } => ball::<M>(p, centre, radius),
-            Shape::Capsule { a, b, radius } => {
-                let axis = b - a;
-                let length2 = axis.dot(axis);
-                let t = if length2 > 0.0 {
-                    ((p - a).dot(axis) / length2).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                };
-                ball::<M>(p, a + axis * t, radius)
-            }
+            Shape::Capsule { a, b, radius } => ball::<M>(p, closest_on_segment(p, a, b), radius),
             Shape::Plane { point, normal } => {
                 let distance = (p - point).dot(normal);
                 (distance < 0.0).then_some(Contact {
@@ -170,6 +161,20 @@ impl Shape {
             }
         }
     }
+}
+
+/// The point of the segment `a`–`b` closest to `p` (a capsule's axis point for `p`).
+#[inline]
+#[must_use]
+pub fn closest_on_segment(p: Vec3, a: Vec3, b: Vec3) -> Vec3 {
+    let axis = b - a;
+    let length2 = axis.dot(axis);
+    let t = if length2 > 0.0 {
+        ((p - a).dot(axis) / length2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    a + axis * t
 }
 
 /// Contact of `p` with the ball of `radius` about `centre`. A point exactly at the centre is

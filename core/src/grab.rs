@@ -147,3 +147,12 @@ pub fn grabbed_nodes(
     }
     held
 }
+
+/// After a step: every grab whose bit is set in `report.grabs_slipped` stops holding its node.
+pub fn apply_slips(grabs: &mut [Grab], report: &crate::report::StepReport) {
+    for (g, grab) in grabs.iter_mut().enumerate().take(MAX_GRABS) {
+        if report.grabs_slipped & (1 << g) != 0 {
+            grab.status = GrabStatus::Slipped;
+        }
+    }
+}

@@ -257,11 +257,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             input.accelerations,
             &mut report,
         );
-        for (g, grab) in self.grabs.iter_mut().enumerate() {
-            if report.grabs_slipped & (1 << g) != 0 {
-                grab.status = GrabStatus::Slipped;
-            }
-        }
+        crate::grab::apply_slips(&mut self.grabs, &report);
         self.head = head;
         self.steps += 1;
         report

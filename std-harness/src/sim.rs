@@ -206,11 +206,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
         for r in &reports {
             report.merge(r);
         }
-        for (g, grab) in self.grabs.iter_mut().enumerate() {
-            if report.grabs_slipped & (1 << g) != 0 {
-                grab.status = GrabStatus::Slipped;
-            }
-        }
+        hairsim_core::grab::apply_slips(&mut self.grabs, &report);
         self.head = head;
         self.steps += 1;
         report

@@ -292,14 +292,7 @@ fn surface<M: Math>(shape: &Shape, p: Vec3) -> (Vec3, Real) {
     match *shape {
         Shape::Sphere { centre, radius } => ball(centre, radius),
         Shape::Capsule { a, b, radius } => {
-            let axis = b - a;
-            let length2 = axis.dot(axis);
-            let t = if length2 > 0.0 {
-                ((p - a).dot(axis) / length2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            ball(a + axis * t, radius)
+            ball(crate::collide::closest_on_segment(p, a, b), radius)
         }
         Shape::Plane { point, normal } => (normal, -(p - point).dot(normal)),
     }
