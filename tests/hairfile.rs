@@ -705,3 +705,65 @@ fn a_core_world_run_goes_through_out_dir() {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
+
+/// What a graphics person tries first — `hairsim run model.tfx` with no options — runs every
+/// real sample stably in human units: the automatic scale gives a head of
+/// [`hairscene::HEAD_RADIUS`] (or hair of human length), the default DFTL scene rolls nothing
+/// back, keeps segments at length and nodes out of the head.
+#[test]
+fn real_samples_run_in_their_default_scene() {
+    use hairsim::hairscene::{HAIR_LENGTH, HEAD_RADIUS};
+    use hairsim::run::{load, run, HairFileOptions, RunOptions};
+    use hairsim_core::Shape;
+    let Some(dir) = samples("real_samples_run_in_their_default_scene") else {
+        return;
+    };
+    for name in ["straight.hair", "sintel_hair.tfx", "Ratboy_mohawk.tfx"] {
+        let path = dir.join(name);
+        let loaded = load(path.to_str().unwrap(), &HairFileOptions::default())
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        match loaded.prepared.colliders.first().map(|c| c.shape) {
+            Some(Shape::Sphere { radius, .. }) => {
+                assert!(
+                    (radius - 0.97 * HEAD_RADIUS).abs() < 1e-4,
+                    "{name}: head {radius}"
+                );
+            }
+            _ => {
+                let mut lengths: Vec<f32> = loaded
+                    .prepared
+                    .strands
+                    .iter()
+                    .map(|s| polyline_length(&s.points))
+                    .collect();
+                lengths.sort_by(f32::total_cmp);
+                let median = lengths[lengths.len() / 2];
+                assert!(
+                    (median - HAIR_LENGTH).abs() < 0.05 * HAIR_LENGTH,
+                    "{name}: {median}"
+                );
+            }
+        }
+        let summary = run(
+            &loaded,
+            &RunOptions {
+                steps: Some(300),
+                ..RunOptions::default()
+            },
+        )
+        .unwrap();
+        assert!(summary.finite, "{name}");
+        assert_eq!(summary.rolled_back, 0, "{name}");
+        assert!(
+            summary.max_stretch < 1e-3,
+            "{name}: stretch {}",
+            summary.max_stretch
+        );
+        assert!(
+            summary.max_penetration < 1e-4,
+            "{name}: depth {}",
+            summary.max_penetration
+        );
+        assert!(summary.hair_file.is_some(), "{name}");
+    }
+}

@@ -1,6 +1,18 @@
-//! The default scene around a hair file (`hairsim run head.hair`): the rod solver at 1 ms,
-//! gravity, drag, bending, twist and inextensibility, the head still, and a head sphere fitted
-//! to the strands' roots (with collisions on) when the roots outline one.
+//! The default scene around a hair file (`hairsim run head.hair`): DFTL with shape
+//! preservation at 1 ms, gravity, drag and inextensibility, the head still, and a head sphere
+//! fitted to the strands' roots (with collisions on) when the roots outline one.
+//!
+//! Why DFTL and not the rod: real hair files hold tight curls and short, uneven segments, which
+//! put an explicit rod far past its stability limit at 1 ms; DFTL is stable for any shape at a
+//! fixed cost, and its shape constraints keep the style the file was made with. A TOML scene
+//! with a `[hair.file]` table runs a file with the rod.
+//!
+//! Units: without `--scale` the file is scaled so that the head fitted to its roots has
+//! [`HEAD_RADIUS`] (or, with no head to fit, so that its median strand is [`HAIR_LENGTH`]
+//! long): exporters use centimetres, decimetres or arbitrary units, and a scene in the wrong
+//! units runs hair a hundred times too short or too long. The summary names the scale chosen.
+//! Without `--up` a `.hair` file is taken as Z-up (Cem Yuksel's models are) and a `.tfx` as
+//! Y-up (TressFX's convention).
 //!
 //! The file is read (by the `hairfile` module) once here to fit the head to its roots, and
 //! again when the scene is prepared, like any `[hair.file]`.
@@ -16,6 +28,10 @@ use crate::scene::{ColliderSpec, FieldError, FileSpec, HairSpec, Scene, FORMAT};
 pub const DEFAULT_MAX_STRANDS: u32 = 1000;
 /// Nodes every strand is resampled to in the default scene.
 pub const DEFAULT_NODES: u32 = 24;
+/// Radius of the head fitted to a file's roots once scaled, m (an adult head).
+pub const HEAD_RADIUS: f32 = 0.09;
+/// Median strand length of a file with no head to fit once scaled, m.
+pub const HAIR_LENGTH: f32 = 0.25;
 
 /// The default scene for the hair file at `path`.
 pub fn scene_for_hair_file(path: &Path, options: &HairFileOptions) -> Result<Scene, FieldError> {
@@ -26,12 +42,40 @@ pub fn scene_for_hair_file(path: &Path, options: &HairFileOptions) -> Result<Sce
         return Ok(bare);
     };
     let model = crate::scene::prepare::read_hair_file(file, Path::new("."))?;
-    let roots: Vec<Vec3> = model
+    let mut roots: Vec<Vec3> = model
         .strands
         .iter()
         .filter_map(|s| s.first().copied())
         .collect();
-    Ok(scene_around(path, options, &roots))
+    let mut options = options.clone();
+    if options.scale.is_none() {
+        let scale = automatic_scale(&roots, &model.strands);
+        roots.iter_mut().for_each(|r| *r *= scale);
+        options.scale = Some(scale);
+    }
+    Ok(scene_around(path, &options, &roots))
+}
+
+/// The factor that gives a file read in its own units a human size: the head fitted to its
+/// `roots` becomes [`HEAD_RADIUS`] across, or, with no head to fit, the median of `strands`'
+/// lengths becomes [`HAIR_LENGTH`]; 1 when neither can be measured.
+#[must_use]
+pub fn automatic_scale(roots: &[Vec3], strands: &[Vec<Vec3>]) -> f32 {
+    if let Some((_, radius)) = fit_sphere_within(roots, f32::MAX) {
+        if radius > 0.0 {
+            return HEAD_RADIUS / radius;
+        }
+    }
+    let mut lengths: Vec<f32> = strands
+        .iter()
+        .map(|s| s.windows(2).map(|w| (w[1] - w[0]).length()).sum())
+        .filter(|l: &f32| l.is_finite() && *l > 0.0)
+        .collect();
+    lengths.sort_by(f32::total_cmp);
+    match lengths.get(lengths.len() / 2) {
+        Some(median) => HAIR_LENGTH / median,
+        None => 1.0,
+    }
 }
 
 /// The default scene for the hair file at `path` whose strand roots (after `--scale` and
@@ -52,10 +96,16 @@ pub fn scene_around(path: &Path, options: &HairFileOptions, roots: &[Vec3]) -> S
         })
         .take(64)
         .collect();
-    let mut effects: Vec<String> = ["gravity", "drag", "bending", "twist", "inextensibility"]
+    let mut effects: Vec<String> = ["gravity", "drag", "inextensibility", "shape"]
         .iter()
         .map(|e| (*e).to_string())
         .collect();
+    let up = options.up.clone().or_else(|| {
+        let hair = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("hair"));
+        Some(if hair { "z" } else { "y" }.to_string())
+    });
     let colliders: Vec<ColliderSpec> = fit_sphere(roots)
         .map(|(centre, radius)| ColliderSpec {
             shape: "sphere".into(),
@@ -77,7 +127,7 @@ pub fn scene_around(path: &Path, options: &HairFileOptions, roots: &[Vec3]) -> S
         format: FORMAT,
         name: if name.is_empty() { "hair".into() } else { name },
         about: Some(format!("default scene around {}", path.display())),
-        solver: "rod".into(),
+        solver: "dftl".into(),
         dt: 0.001,
         steps: Some(1000),
         duration: None,
@@ -94,7 +144,7 @@ pub fn scene_around(path: &Path, options: &HairFileOptions, roots: &[Vec3]) -> S
         hair: Some(HairSpec::File(FileSpec {
             path: path.display().to_string(),
             scale: options.scale,
-            up: options.up.clone(),
+            up,
             nodes: Some(DEFAULT_NODES),
             max_strands: Some(DEFAULT_MAX_STRANDS),
             min_length: None,
@@ -109,9 +159,15 @@ pub fn scene_around(path: &Path, options: &HairFileOptions, roots: &[Vec3]) -> S
 
 /// The sphere through `points` in the least-squares sense (algebraic fit:
 /// `|p|² = 2 c·p + (r² − |c|²)`, solved by Gaussian elimination in `f64`), or `None` when the
-/// points do not outline a sphere (fewer than 4, nearly coplanar, or a radius past 10 m).
+/// points do not outline a head (fewer than 4, nearly coplanar, spread along a strip rather
+/// than over a scalp, or a radius past 10 m).
 #[must_use]
 pub fn fit_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {
+    fit_sphere_within(points, 10.0)
+}
+
+/// [`fit_sphere`] with a radius of at most `max_radius`.
+fn fit_sphere_within(points: &[Vec3], max_radius: f32) -> Option<(Vec3, f32)> {
     if points.len() < 4 {
         return None;
     }
@@ -152,8 +208,22 @@ pub fn fit_sphere(points: &[Vec3]) -> Option<(Vec3, f32)> {
     let k = m[3][4] / m[3][3];
     let r2 = k + c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
     let r = libm::sqrt(r2);
-    (r2 > 0.0 && r <= 10.0 && c.iter().all(|v| v.is_finite()))
+    let fits = r2 > 0.0 && r <= f64::from(max_radius) && c.iter().all(|v| v.is_finite());
+    (fits && covers_a_scalp(points, r as f32))
         .then(|| (Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32), r as f32))
+}
+
+/// Whether `points` spread over a scalp of a sphere of `radius` rather than along a line on
+/// it: the bounding box's second-largest side is at least half the radius. A mohawk's roots
+/// lie on a narrow strip, which fits a sphere of any size and is no head.
+fn covers_a_scalp(points: &[Vec3], radius: f32) -> bool {
+    let (lo, hi) = points.iter().fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let mut sides = (hi - lo).to_array();
+    sides.sort_by(f32::total_cmp);
+    sides[1] >= 0.5 * radius
 }
 
 #[cfg(test)]
@@ -180,6 +250,33 @@ mod tests {
             .map(|i| Vec3::new((i % 5) as f32, 0.0, (i / 5) as f32))
             .collect();
         assert_eq!(fit_sphere(&plane), None);
+        // A mohawk: roots along a narrow strip over the top of a head.
+        let strip: Vec<Vec3> = (0..40)
+            .map(|i| {
+                let a = -1.0 + 0.05 * i as f32;
+                let x = 0.004 * (i % 3) as f32;
+                Vec3::new(x, 0.1 * a.cos(), 0.1 * a.sin())
+            })
+            .collect();
+        assert_eq!(fit_sphere(&strip), None);
+    }
+
+    #[test]
+    fn the_automatic_scale_makes_a_head_of_human_size() {
+        // A scalp in centimetres: the head fitted to it becomes HEAD_RADIUS across.
+        let roots: Vec<Vec3> = scalp_roots(200, Vec3::ZERO, 9.0, 1.0)
+            .into_iter()
+            .map(|(p, _)| p)
+            .collect();
+        let scale = automatic_scale(&roots, &[]);
+        assert!((scale - HEAD_RADIUS / 9.0).abs() < 1e-6, "{scale}");
+        // No head to fit: the median strand becomes HAIR_LENGTH long.
+        let strands: Vec<Vec<Vec3>> = [2.0f32, 5.0, 50.0]
+            .iter()
+            .map(|&l| vec![Vec3::ZERO, Vec3::new(0.0, -l, 0.0)])
+            .collect();
+        assert!((automatic_scale(&[Vec3::ZERO; 3], &strands) - HAIR_LENGTH / 5.0).abs() < 1e-6);
+        assert_eq!(automatic_scale(&[], &[]), 1.0);
     }
 
     #[test]

@@ -12,9 +12,9 @@ use hairsim_core::{DefaultMath, Math, StepReport};
 use crate::builtin;
 use crate::output;
 use crate::record::{BuildIdentity, Checkpoint, RecordedInputs, Recording, CAPACITIES, VERSION};
-use crate::scene::{Prepared, Scene, SceneError};
+use crate::scene::{HairSpec, Prepared, Scene, SceneError};
 use crate::sim::{scene_inputs, Sim, StepInputs};
-use crate::summary::{hash_string, Summary};
+use crate::summary::{hash_string, HairFileUsed, Summary};
 
 /// A scene ready to run, and where it came from.
 #[derive(Clone, Debug)]
@@ -396,6 +396,14 @@ fn run_n<const N: usize, M: Math>(
             .iter()
             .map(|e| e.name().to_string())
             .collect(),
+        hair_file: match &loaded.scene.hair {
+            Some(HairSpec::File(file)) => Some(HairFileUsed {
+                path: file.path.clone(),
+                scale: file.scale.unwrap_or(1.0),
+                up: file.up.clone().unwrap_or_else(|| "y".into()),
+            }),
+            _ => None,
+        },
         steps,
         dt: prepared.params.dt,
         strands: sim.strands.len(),

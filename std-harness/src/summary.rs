@@ -57,12 +57,27 @@ pub struct Summary {
     /// Neighbours the SPH cap dropped, over the run (only with `hair-hair`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sph_truncated: Option<u64>,
+    /// The hair file the scene read, with the scale and up axis it was read with (only with
+    /// a hair file).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hair_file: Option<HairFileUsed>,
     /// Files written by `--out` (empty without it).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub written: Vec<String>,
     /// Each collider's total contact force after the last step, N (only with colliders).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub collider_forces: Option<Vec<[f32; 3]>>,
+}
+
+/// A hair file as a run read it.
+#[derive(Clone, Debug, Serialize)]
+pub struct HairFileUsed {
+    /// The file's path.
+    pub path: String,
+    /// Factor from the file's units to metres.
+    pub scale: f32,
+    /// The file's up axis, `y` or `z`.
+    pub up: String,
 }
 
 /// Formats a state hash the way every tool prints it.
@@ -125,6 +140,12 @@ impl Summary {
         if let (Some(mean), Some(truncated)) = (self.sph_neighbours, self.sph_truncated) {
             text.push_str(&format!(
                 "\nhair-hair   {mean:.1} neighbours per node, {truncated} dropped by the cap"
+            ));
+        }
+        if let Some(file) = &self.hair_file {
+            text.push_str(&format!(
+                "\nhair file   {} (scale {:.4e} to metres, {}-up)",
+                file.path, file.scale, file.up
             ));
         }
         if let Some(last) = self.written.last() {

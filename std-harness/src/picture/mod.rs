@@ -162,6 +162,14 @@ enum Solid {
     Stadium { a: Point, b: Point, radius: f32 },
 }
 
+impl Solid {
+    fn radius(&self) -> f32 {
+        match *self {
+            Solid::Disc { radius, .. } | Solid::Stadium { radius, .. } => radius,
+        }
+    }
+}
+
 fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid) {
     let mut paint = Paint {
         anti_alias: true,
@@ -242,7 +250,7 @@ pub fn render<S: AsRef<[Vec3]>>(
         }
     }
 
-    // Colliders far to near (a stable sort keeps the caller's order among equal depths).
+    // Colliders far to near.
     let mut solids: Vec<(f32, Solid)> = Vec::new();
     for shape in colliders {
         match *shape {
@@ -270,7 +278,12 @@ pub fn render<S: AsRef<[Vec3]>>(
             Shape::Plane { .. } => {}
         }
     }
-    solids.sort_by(|x, y| y.0.total_cmp(&x.0));
+    // Among colliders at the same depth the larger is drawn last: a neck capsule centred in
+    // the head's plane is hidden by the head, not drawn over its chin.
+    solids.sort_by(|x, y| {
+        y.0.total_cmp(&x.0)
+            .then_with(|| x.1.radius().total_cmp(&y.1.radius()))
+    });
 
     // Strand pieces are sorted into layers: layer k holds the pieces with k colliders behind
     // them (by midpoint depth), drawn after those k colliders and before the rest. Each piece

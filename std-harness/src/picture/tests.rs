@@ -84,6 +84,39 @@ fn colliders_are_filled_and_hide_hair_behind_them() {
 }
 
 #[test]
+fn a_neck_in_the_head_plane_is_drawn_behind_the_head() {
+    let style = Style::default();
+    let head = Shape::Sphere {
+        centre: Vec3::ZERO,
+        radius: 0.1,
+    };
+    let neck = Shape::Capsule {
+        a: Vec3::new(0.0, -0.05, 0.0),
+        b: Vec3::new(0.0, -0.2, 0.0),
+        radius: 0.04,
+    };
+    let camera = Camera::fit(
+        (Vec3::splat(-0.25), Vec3::splat(0.25)),
+        View::Front,
+        200,
+        200,
+    );
+    // Listed head first, as the scenes do: the head's chin outline must still show over the
+    // neck, and the neck below the chin is filled.
+    let p = render::<Vec<Vec3>>(&[], &[head, neck], &camera, &style).unwrap();
+    let at = |q: Vec3| {
+        let (c, _) = camera.project(q);
+        pixel(&p, c.x as u32, c.y as u32)
+    };
+    assert_ne!(
+        at(Vec3::new(0.0, -0.1, 0.0)),
+        style.collider_fill,
+        "chin outline"
+    );
+    assert_eq!(at(Vec3::new(0.0, -0.15, 0.0)), style.collider_fill, "neck");
+}
+
+#[test]
 fn capsules_and_planes_are_drawn() {
     let style = Style::default();
     let capsule = Shape::Capsule {
