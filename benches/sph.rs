@@ -113,13 +113,15 @@ fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, 
             let s = &sph.stats;
             let ms = |t: Duration| t.as_secs_f64() * 1e3 / steps as f64;
             format!(
-                "  sph ms/step: sort {:.2}, neighbours {:.2}, forces {:.2}; {:.1} neighbours/node (cap {}, {:.1} dropped/node)",
+                "  sph ms/step: hash {:.2}, sort {:.2}, neighbours {:.2}, forces {:.2}; {:.1} neighbours/node (cap {}, {:.1} dropped/node, most found {})",
+                ms(s.time_hash - b.time_hash),
                 ms(s.time_sort - b.time_sort),
                 ms(s.time_neighbours - b.time_neighbours),
                 ms(s.time_forces - b.time_forces),
                 (s.neighbours - b.neighbours) as f64 / (steps as f64 * vertices as f64),
                 sph.params().neighbour_cap,
                 (s.truncated - b.truncated) as f64 / (steps as f64 * vertices as f64),
+                s.max_neighbours_found,
             )
         });
         (wall, cpu, split)
