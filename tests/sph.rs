@@ -149,3 +149,50 @@ fn one_and_two_threads_give_the_same_state_hash_after_200_steps() {
     };
     assert_eq!(hash(1), hash(2));
 }
+
+/// Mannequin B (the built-in, DFTL + shape + hair–hair), with or without `hair-hair`.
+fn mannequin_b(hair_hair: bool) -> hairsim::scene::Prepared {
+    let mut scene = (hairsim::builtin::find("mannequin-b").unwrap().scene)();
+    if !hair_hair {
+        scene.effects.retain(|e| e != "hair-hair");
+    }
+    scene.prepare().unwrap()
+}
+
+#[test]
+fn the_stage_counter_says_whether_hair_hair_ran() {
+    use hairsim::sim::{scene_inputs, Sim};
+    use hairsim_core::{DefaultMath, Stage};
+    for on in [false, true] {
+        let prepared = mannequin_b(on);
+        let mut sim = Sim::<16, DefaultMath>::new(&prepared, 1).unwrap();
+        assert_eq!(sim.sph.is_some(), on);
+        for k in 0..3 {
+            let report = sim.step(&scene_inputs::<DefaultMath>(&prepared, k));
+            let expected = if on { prepared.strands.len() as u32 } else { 0 };
+            assert_eq!(report.runs(Stage::HairHair), expected, "hair-hair {on}");
+            // The strands' own stages ran either way.
+            assert_eq!(report.runs(Stage::Shape), prepared.strands.len() as u32);
+        }
+        if let Some(sph) = &sim.sph {
+            assert_eq!(sph.stats.runs, 3);
+        }
+    }
+}
+
+#[test]
+fn the_harness_gives_one_and_two_threads_the_same_hash_with_hair_hair() {
+    use hairsim::sim::{scene_inputs, Sim};
+    use hairsim_core::DefaultMath;
+    let prepared = mannequin_b(true);
+    let hash = |threads: usize| {
+        let mut sim = Sim::<16, DefaultMath>::new(&prepared, threads).unwrap();
+        for k in 0..200 {
+            sim.step(&scene_inputs::<DefaultMath>(&prepared, k));
+        }
+        assert!(sim.is_finite());
+        assert!(sim.sph.as_ref().unwrap().stats.neighbours > 0);
+        sim.state_hash()
+    };
+    assert_eq!(hash(1), hash(2));
+}

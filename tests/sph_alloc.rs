@@ -1,5 +1,5 @@
 //! A step of the SPH stage allocates nothing: every buffer is sized when the stage is built.
-//! Its own test binary, so that no other test allocates while this one counts.
+//! Its own test binary, with a single test, so that nothing else allocates while it counts.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -24,8 +24,15 @@ static GLOBAL: Counting = Counting;
 
 const N: usize = 16;
 
+/// One test running both checks in turn: two tests would run on two threads at once and
+/// count each other's allocations.
 #[test]
-fn a_step_allocates_nothing() {
+fn sph_and_sim_steps_allocate_nothing() {
+    an_sph_step_allocates_nothing();
+    a_sim_step_with_hair_hair_allocates_nothing();
+}
+
+fn an_sph_step_allocates_nothing() {
     let mut strands: Vec<Strand<N>> = (0..40)
         .map(|k| {
             let offset = Vec3::new(0.0, 0.0001 * k as f32, 0.00007 * (k % 5) as f32);
@@ -63,6 +70,38 @@ fn a_step_allocates_nothing() {
             after - before,
             0,
             "SPH steps allocated {} times",
+            after - before
+        );
+    });
+}
+
+/// A whole step of the harness's `Sim` — SPH, then the strands' blocks on two threads, the
+/// reports merged — with hair–hair on allocates nothing once set up.
+fn a_sim_step_with_hair_hair_allocates_nothing() {
+    use hairsim::sim::{scene_inputs, Sim};
+    use hairsim_core::{DefaultMath, Stage};
+    let scene = (hairsim::builtin::find("mannequin-b").unwrap().scene)();
+    let prepared = scene.prepare().unwrap();
+    let inputs: Vec<_> = (0..20)
+        .map(|k| scene_inputs::<DefaultMath>(&prepared, k))
+        .collect();
+    let mut sim = Sim::<16, DefaultMath>::new(&prepared, 2).unwrap();
+    // Inside the Sim's own pool, as a run goes: no work injected from outside per step.
+    sim.in_pool(|sim| {
+        for i in &inputs[..5] {
+            sim.step(i);
+        }
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        let mut ran = 0;
+        for i in &inputs[5..] {
+            ran += sim.step(i).runs(Stage::HairHair);
+        }
+        let after = ALLOCATIONS.load(Ordering::Relaxed);
+        assert_eq!(ran, 15 * 500, "hair-hair ran on every strand at every step");
+        assert_eq!(
+            after - before,
+            0,
+            "Sim steps allocated {} times",
             after - before
         );
     });

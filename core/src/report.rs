@@ -19,6 +19,10 @@ use crate::math::{Real, Vec3};
 /// 9. `Collisions` — contacts found and resolved.
 /// 10. `Velocity` — velocity update from the position change.
 /// 11. `Guard` — non-finite check, rollback.
+///
+/// `HairHair` is the harness's SPH stage (Sánchez-Banderas 2015 Algorithm 1, lines 1–11): it
+/// runs before all of these, outside the core, once per step for all strands at once; the
+/// harness counts it (for every strand it computed accelerations for) when it runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
@@ -45,10 +49,12 @@ pub enum Stage {
     Velocity = 9,
     /// Non-finite check and rollback.
     Guard = 10,
+    /// Hair–hair interaction (SPH, in the harness), before the strands' own stages.
+    HairHair = 11,
 }
 
 /// Number of [`Stage`]s.
-pub const STAGE_COUNT: usize = 11;
+pub const STAGE_COUNT: usize = 12;
 
 /// Most strand indices a report names individually (the count is always exact).
 pub const NAMED_STRANDS: usize = 8;

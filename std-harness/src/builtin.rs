@@ -3,7 +3,8 @@
 //!
 //! The papers' scenarios: Kmoch 2009 Table 1 (`stand-1` … `stand-3`, `head-1` … `head-3`;
 //! strand counts there include the followers) and Sánchez-Banderas 2015 Table 1
-//! (`mannequin-b`: 500 strands, 8,000 vertices).
+//! (`mannequin-a`: 15,000 strands, ~349,000 vertices; `mannequin-b`: 500 strands, 8,000
+//! vertices; both with DFTL + shape + hair–hair, the table's third column).
 
 use hairsim_core::scenes::{firmware, firmware_dftl};
 use hairsim_core::{DefaultMath, Math, Params, Shake, World};
@@ -71,9 +72,14 @@ pub const BUILTINS: &[Builtin] = &[
         scene: || head("head-3", 25, 2475, true),
     },
     Builtin {
+        name: "mannequin-a",
+        about: "Sanchez-Banderas 2015 Mannequin A: 15,000 DFTL strands x 23 nodes (345,000 vertices; the paper's 349,232) with shape preservation and hair-hair (SPH) on a turning mannequin",
+        scene: || mannequin("mannequin-a", 15_000, 23),
+    },
+    Builtin {
         name: "mannequin-b",
-        about: "Sanchez-Banderas 2015 Mannequin B: 500 DFTL strands x 16 nodes (8,000 vertices) with shape preservation on a turning mannequin",
-        scene: mannequin_b,
+        about: "Sanchez-Banderas 2015 Mannequin B: 500 DFTL strands x 16 nodes (8,000 vertices) with shape preservation and hair-hair (SPH) on a turning mannequin",
+        scene: || mannequin("mannequin-b", 500, 16),
     },
     Builtin {
         name: "haptic",
@@ -342,17 +348,31 @@ fn head(name: &str, leaders: u32, followers: u32, wavy: bool) -> Scene {
     scene
 }
 
-fn mannequin_b() -> Scene {
-    let effects = ["gravity", "drag", "inextensibility", "collisions", "shape"];
-    let mut scene = base(
-        "mannequin-b",
-        about("mannequin-b"),
-        "dftl",
-        1.0 / 60.0,
-        600,
-        &effects,
-    );
+/// The paper's mannequin at two levels of detail (Table 1: Mannequin A and B): the same head,
+/// body and 25 cm of hair, `leaders` strands of `nodes` nodes, with DFTL, shape preservation and
+/// hair–hair interaction (the table's third column), at the paper's Δt of 1/60 s.
+fn mannequin(name: &str, leaders: u32, nodes: u32) -> Scene {
+    let effects = [
+        "gravity",
+        "drag",
+        "inextensibility",
+        "collisions",
+        "shape",
+        "hair-hair",
+    ];
+    let mut scene = base(name, about(name), "dftl", 1.0 / 60.0, 600, &effects);
     scene.drag = Some(2.0e-7);
+    // Smoothing length: the root spacing of Mannequin A is ~1.8 mm and its segments 11 mm, so
+    // 6 mm reaches a few neighbouring strands (about 10 neighbours a node on the head); the
+    // repulsion and viscosity within the paper's ranges ([0, 0.5], [0, 200]).
+    scene.hair_hair = Some(crate::scene::HairHairSpec {
+        smoothing_length: Some(0.006),
+        rest_density: Some(2.0),
+        stiffness: Some(0.2),
+        viscosity: Some(20.0),
+        max_neighbours: Some(24),
+        skip_same_strand: Some(3),
+    });
     // The head turns to one side and back over two seconds.
     scene.head = Some(HeadSpec {
         motion: Some(MotionSpec::Keyframes(KeyframesSpec {
@@ -374,8 +394,8 @@ fn mannequin_b() -> Scene {
         capsule([0.0, -0.25, 0.0], [0.0, -0.6, 0.0], 0.15),
     ];
     scene.hair = Some(HairSpec::Scalp(ScalpSpec {
-        leaders: 500,
-        nodes: 16,
+        leaders,
+        nodes,
         length: 0.25,
         centre: None,
         radius: Some(0.1),

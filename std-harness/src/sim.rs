@@ -8,7 +8,7 @@ use hairsim_core::context::StepContext;
 use hairsim_core::grab::GrabStatus;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::{
-    step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, StepReport, Strand, Vec3,
+    step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, Stage, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -71,7 +71,9 @@ pub struct Sim<const N: usize, M: Math> {
     block: usize,
     dftl: DftlCoefficients,
     accelerations: Vec<Vec3>,
-    pool: Option<rayon::ThreadPool>,
+    /// One report per block of strands, reused every step (a step allocates nothing).
+    block_reports: Vec<StepReport>,
+    pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     math: std::marker::PhantomData<M>,
 }
 
@@ -95,14 +97,14 @@ impl<const N: usize, M: Math> Sim<N, M> {
             .map(|g| Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit))
             .collect();
         let pool = if threads > 1 {
-            Some(
+            Some(std::sync::Arc::new(
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
                     .build()
                     .map_err(|e| {
                         FieldError::new("--threads", format!("cannot start threads: {e}"))
                     })?,
-            )
+            ))
         } else {
             None
         };
@@ -112,8 +114,10 @@ impl<const N: usize, M: Math> Sim<N, M> {
             }
             None => None,
         };
+        let block = prepared.block.max(1);
         Ok(Sim {
             params: prepared.params,
+            block_reports: vec![StepReport::default(); strands.len().div_ceil(block)],
             accelerations: if sph.is_some() {
                 vec![Vec3::ZERO; strands.len() * N]
             } else {
@@ -125,7 +129,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
             head,
             steps: 0,
             sph,
-            block: prepared.block.max(1),
+            block,
             // Computed once, as `World::configure` does (two `powf`, never per step).
             dftl: prepared.params.dftl.at_step(prepared.params.dt),
             pool,
@@ -143,6 +147,20 @@ impl<const N: usize, M: Math> Sim<N, M> {
     #[must_use]
     pub fn is_finite(&self) -> bool {
         self.strands.iter().all(Strand::is_finite)
+    }
+
+    /// Runs `f` on this simulation inside its thread pool (directly when it has none). Steps
+    /// taken inside do not hand work to the pool from outside at every step: a whole run can
+    /// go through here, and so can a test that counts allocations (rayon's queue for work
+    /// injected from outside allocates a block now and then; a worker's own deque does not).
+    pub fn in_pool<R: Send>(&mut self, f: impl FnOnce(&mut Self) -> R + Send) -> R
+    where
+        M: Send,
+    {
+        match self.pool.clone() {
+            Some(pool) => pool.install(|| f(self)),
+            None => f(self),
+        }
     }
 
     /// Advances by one step with `inputs`.
@@ -181,29 +199,43 @@ impl<const N: usize, M: Math> Sim<N, M> {
                     Some(pool) => pool.install(|| sph.accelerations(strands, dt, out)),
                     None => sph.accelerations(strands, dt, out),
                 }
+                // Counted like the core's stages: the strands it ran on.
+                report.stage_runs[Stage::HairHair as usize] +=
+                    u32::try_from(strands.len()).unwrap_or(u32::MAX);
                 Some(self.accelerations.as_slice())
             }
             _ => None,
         };
         let block = self.block;
         let grabs = self.grabs.as_slice();
-        let blocks: Vec<(usize, &mut [Strand<N>])> =
-            self.strands.chunks_mut(block).enumerate().collect();
-        let step_block = |(b, strands): (usize, &mut [Strand<N>])| {
-            let mut r = StepReport::default();
+        let step_block = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
+            *r = StepReport::default();
             let acc =
                 accelerations.and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
-            step_strands::<M, N>(&ctx, strands, (b * block) as u32, grabs, acc, &mut r);
-            r
+            step_strands::<M, N>(&ctx, strands, (b * block) as u32, grabs, acc, r);
         };
-        let reports: Vec<StepReport> = match &self.pool {
-            Some(pool) if blocks.len() > 1 => {
-                pool.install(|| blocks.into_par_iter().map(step_block).collect())
+        let reports = &mut self.block_reports;
+        match &self.pool {
+            Some(pool) if reports.len() > 1 => pool.install(|| {
+                self.strands
+                    .par_chunks_mut(block)
+                    .zip(reports.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(b, (strands, r))| step_block(b, strands, r));
+            }),
+            _ => {
+                for (b, (strands, r)) in self
+                    .strands
+                    .chunks_mut(block)
+                    .zip(reports.iter_mut())
+                    .enumerate()
+                {
+                    step_block(b, strands, r);
+                }
             }
-            _ => blocks.into_iter().map(step_block).collect(),
-        };
+        }
         // Block order, never completion order: the same sums whatever the thread count.
-        for r in &reports {
+        for r in reports.iter() {
             report.merge(r);
         }
         hairsim_core::grab::apply_slips(&mut self.grabs, &report);

@@ -48,6 +48,7 @@ fn scenes_lists_one_builtin_per_line_starting_with_its_name() {
         "head-1",
         "head-2",
         "head-3",
+        "mannequin-a",
         "mannequin-b",
         "haptic",
     ] {

@@ -1,24 +1,18 @@
 //! The spatial hash and the stable counting sort (Sánchez-Banderas 2015, Sec. 4; Algorithm 1
 //! lines 2–4). Cells are cubes of the smoothing length `h`, so every neighbour of a particle
-//! lies in its own cell or one of the 26 around it. Cells map to a power-of-two number of
-//! buckets by a hash of their integer coordinates; distinct cells may share a bucket, which the
-//! neighbour search filters by distance.
+//! lies in its own cell or one of the 26 around it.
+//!
+//! Cells map to a power-of-two number of buckets laid out in *rows*: the row of a cell is a
+//! hash of its `(y, z)` coordinates, and within a row 16 consecutive buckets take `x mod 16`.
+//! Three cells side by side along x are then (but at the wrap of 16) three consecutive
+//! buckets, which after the sort are one contiguous run of particles: the 27 cells around a
+//! particle are at most 9 rows, read as at most 18 contiguous ranges of the sorted arrays.
+//! Distinct cells may share a bucket; the neighbour search filters by distance.
 
 use hairsim_core::Vec3;
 
-/// The grid: bucket of each particle, the counting sort's output, and its scratch.
-#[derive(Clone, Debug)]
-pub struct Grid {
-    inverse_cell: f32,
-    mask: u32,
-    /// Bucket of each particle (unsorted order).
-    bucket: Vec<u32>,
-    /// `bucket_start[b] .. bucket_start[b + 1]` are bucket `b`'s particles in sorted order.
-    pub bucket_start: Vec<u32>,
-    cursor: Vec<u32>,
-    /// Sorted position `k` holds particle `order[k]`.
-    pub order: Vec<u32>,
-}
+/// Buckets in a row (consecutive cells along x).
+pub const ROW: u32 = 16;
 
 /// Integer cell coordinates of `p` for cells of size `1 / inverse_cell`. Coordinates are
 /// clamped so that far-away (or non-finite) positions cannot overflow.
@@ -29,29 +23,48 @@ pub fn cell_of(p: Vec3, inverse_cell: f32) -> [i32; 3] {
     [c(p.x), c(p.y), c(p.z)]
 }
 
-/// The bucket of a cell: the classic spatial hash of Teschner et al. 2003.
+/// The row of cells `(·, y, z)`: the spatial hash of Teschner et al. 2003 on two coordinates.
 #[inline]
 #[must_use]
-pub fn bucket_of(cell: [i32; 3], mask: u32) -> u32 {
-    let h = (cell[0] as u32).wrapping_mul(73_856_093)
-        ^ (cell[1] as u32).wrapping_mul(19_349_663)
-        ^ (cell[2] as u32).wrapping_mul(83_492_791);
-    h & mask
+pub fn row_of(y: i32, z: i32, row_mask: u32) -> u32 {
+    ((y as u32).wrapping_mul(19_349_663) ^ (z as u32).wrapping_mul(83_492_791)) & row_mask
+}
+
+/// The bucket of a cell.
+#[inline]
+#[must_use]
+pub fn bucket_of(cell: [i32; 3], row_mask: u32) -> u32 {
+    row_of(cell[1], cell[2], row_mask) * ROW + (cell[0] as u32 & (ROW - 1))
+}
+
+/// The grid: the counting sort's output and its scratch.
+#[derive(Clone, Debug)]
+pub struct Grid {
+    inverse_cell: f32,
+    row_mask: u32,
+    /// `bucket_start[b] .. bucket_start[b + 1]` are bucket `b`'s particles in sorted order.
+    pub bucket_start: Vec<u32>,
+    cursor: Vec<u32>,
+    /// Sorted position `k` holds particle `order[k]`.
+    pub order: Vec<u32>,
+    /// Particle `p` is at sorted position `rank[p]` (the inverse of `order`).
+    pub rank: Vec<u32>,
 }
 
 impl Grid {
-    /// A grid for `particles` particles and cells of size `h`: twice as many buckets as
-    /// particles (rounded up to a power of two) keeps unrelated cells mostly apart.
+    /// A grid for `particles` particles and cells of size `h`: about one bucket per particle
+    /// (a power of two, whole rows), so that unrelated cells are mostly apart.
     #[must_use]
     pub fn new(particles: usize, h: f32) -> Grid {
-        let buckets = (2 * particles).next_power_of_two().max(16);
+        let rows = (particles.next_power_of_two() / ROW as usize).max(16);
+        let buckets = rows * ROW as usize;
         Grid {
             inverse_cell: 1.0 / h,
-            mask: (buckets - 1) as u32,
-            bucket: vec![0; particles],
+            row_mask: (rows - 1) as u32,
             bucket_start: vec![0; buckets + 1],
             cursor: vec![0; buckets],
             order: vec![0; particles],
+            rank: vec![0; particles],
         }
     }
 
@@ -61,21 +74,18 @@ impl Grid {
         self.inverse_cell
     }
 
-    /// The bucket mask (buckets − 1).
+    /// The row mask (rows − 1).
     #[must_use]
-    pub fn mask(&self) -> u32 {
-        self.mask
+    pub fn row_mask(&self) -> u32 {
+        self.row_mask
     }
 
-    /// Hashes particles `0 .. count` (position given by `position`) and sorts them by bucket.
-    /// Stable: within a bucket, particles keep their index order — so the order, and every sum
-    /// taken in it, is a function of the positions alone.
-    pub fn hash_and_sort(&mut self, count: usize, position: impl Fn(usize) -> Vec3) {
-        for (p, b) in self.bucket.iter_mut().enumerate().take(count) {
-            *b = bucket_of(cell_of(position(p), self.inverse_cell), self.mask);
-        }
+    /// Sorts particles `0 .. bucket.len()` by their buckets. Stable: within a bucket particles
+    /// keep their index order — so the order, and every sum taken in it, is a function of
+    /// the positions alone.
+    pub fn sort(&mut self, bucket: &[u32]) {
         self.bucket_start.fill(0);
-        for &b in &self.bucket[..count] {
+        for &b in bucket {
             self.bucket_start[b as usize + 1] += 1;
         }
         for b in 1..self.bucket_start.len() {
@@ -83,11 +93,62 @@ impl Grid {
         }
         let buckets = self.cursor.len();
         self.cursor.copy_from_slice(&self.bucket_start[..buckets]);
-        for (p, &b) in self.bucket[..count].iter().enumerate() {
+        for (p, &b) in bucket.iter().enumerate() {
             let slot = &mut self.cursor[b as usize];
             self.order[*slot as usize] = p as u32;
+            self.rank[p] = *slot;
             *slot += 1;
         }
+    }
+
+    /// The sorted ranges holding every particle of the 27 cells around `cell`: its own row
+    /// first, then the other rows in ascending order, each row once; within a row ascending
+    /// buckets. Returns the ranges and how many there are.
+    #[must_use]
+    pub fn ranges_around(&self, cell: [i32; 3]) -> ([(u32, u32); 18], usize) {
+        let own = row_of(cell[1], cell[2], self.row_mask);
+        let mut rows = [own; 9];
+        let mut n = 1;
+        for dy in -1..=1 {
+            for dz in -1..=1 {
+                let r = row_of(cell[1] + dy, cell[2] + dz, self.row_mask);
+                if !rows[..n].contains(&r) {
+                    rows[n] = r;
+                    n += 1;
+                }
+            }
+        }
+        rows[1..n].sort_unstable();
+        let x = cell[0] as u32 & (ROW - 1);
+        let mut out = [(0, 0); 18];
+        let mut m = 0;
+        for &r in &rows[..n] {
+            let base = (r * ROW) as usize;
+            let span = |lo: u32, hi: u32| {
+                (
+                    self.bucket_start[base + lo as usize],
+                    self.bucket_start[base + hi as usize + 1],
+                )
+            };
+            // x − 1, x, x + 1 within the row of 16, wrapping.
+            match x {
+                0 => {
+                    out[m] = span(0, 1);
+                    out[m + 1] = span(ROW - 1, ROW - 1);
+                    m += 2;
+                }
+                x if x == ROW - 1 => {
+                    out[m] = span(0, 0);
+                    out[m + 1] = span(ROW - 2, ROW - 1);
+                    m += 2;
+                }
+                x => {
+                    out[m] = span(x - 1, x + 1);
+                    m += 1;
+                }
+            }
+        }
+        (out, m)
     }
 }
 
@@ -104,19 +165,66 @@ mod tests {
             })
             .collect();
         let mut grid = Grid::new(points.len(), 0.01);
-        grid.hash_and_sort(points.len(), |p| points[p]);
+        let bucket: Vec<u32> = points
+            .iter()
+            .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.row_mask()))
+            .collect();
+        grid.sort(&bucket);
         let mut seen = vec![false; points.len()];
         for b in 0..grid.cursor.len() {
             let range = grid.bucket_start[b] as usize..grid.bucket_start[b + 1] as usize;
-            let members = &grid.order[range];
+            let members = &grid.order[range.clone()];
             // Stable: ascending particle index within each bucket.
             assert!(members.windows(2).all(|w| w[0] < w[1]));
-            for &p in members {
-                assert_eq!(grid.bucket[p as usize], b as u32);
+            for (k, &p) in range.zip(members) {
+                assert_eq!(bucket[p as usize], b as u32);
+                assert_eq!(grid.rank[p as usize], k as u32);
                 seen[p as usize] = true;
             }
         }
         assert!(seen.iter().all(|&s| s));
+    }
+
+    #[test]
+    fn the_ranges_around_a_cell_hold_its_27_cells_each_particle_once() {
+        // Few rows (16), many cells: rows and buckets collide, and x wraps at 0 and 15.
+        for centre in [[0, 0, 0], [15, 3, -2], [16, -7, 9], [-1, 5, 5], [31, 0, 1]] {
+            let mut points = Vec::new();
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for dz in -1..=1 {
+                        let c = [centre[0] + dx, centre[1] + dy, centre[2] + dz];
+                        points.push(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) + 0.5);
+                    }
+                }
+            }
+            let near = points.len();
+            for k in 0..200 {
+                points.push(Vec3::new(
+                    k as f32 * 7.0 - 700.0,
+                    (k % 13) as f32,
+                    (k % 7) as f32,
+                ));
+            }
+            let mut grid = Grid::new(256, 1.0);
+            let bucket: Vec<u32> = points
+                .iter()
+                .map(|&p| bucket_of(cell_of(p, 1.0), grid.row_mask()))
+                .collect();
+            grid.sort(&bucket);
+            let (ranges, n) = grid.ranges_around(centre);
+            let mut times = vec![0; points.len()];
+            for &(s, e) in &ranges[..n] {
+                for k in s..e {
+                    times[grid.order[k as usize] as usize] += 1;
+                }
+            }
+            assert!(
+                times[..near].iter().all(|&t| t == 1),
+                "{centre:?}: {times:?}"
+            );
+            assert!(times.iter().all(|&t| t <= 1), "{centre:?}");
+        }
     }
 
     #[test]

@@ -6,9 +6,9 @@
 //!    by bucket with a **stable counting sort** (Algorithm 1 lines 2–4);
 //! 2. positions, velocities and masses are rearranged into that order (line 5);
 //! 3. [`neighbours`] builds a capped neighbour list per node (the paper's rough k-nearest list,
-//!    line 6);
-//! 4. [`forces`] computes density (poly6), pressure (spiky gradient) and viscosity (viscosity
-//!    Laplacian) (lines 7–9);
+//!    line 6) and, in the same pass, density (poly6) and pressure (line 7);
+//! 4. [`forces`] computes the pressure (spiky gradient) and viscosity (viscosity Laplacian)
+//!    forces (lines 8–9);
 //! 5. the accelerations go back in the unsorted order, `N` slots per strand, ready for the
 //!    core's per-node acceleration input (lines 10–11).
 //!
@@ -23,6 +23,7 @@ pub mod neighbours;
 use std::time::{Duration, Instant};
 
 use hairsim_core::{Strand, Vec3};
+use rayon::prelude::*;
 
 /// Particles per parallel work item. A constant of the code, never derived from the thread
 /// count, so that the split — and with it every result — is the same on any number of threads.
@@ -90,6 +91,9 @@ impl SphParams {
     }
 }
 
+/// Strands per parallel work item when the accelerations go back to the strands.
+const STRANDS_PER_CHUNK: usize = 64;
+
 /// What the SPH stage did, cumulative over steps.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct SphStats {
@@ -101,11 +105,13 @@ pub struct SphStats {
     pub neighbours: u64,
     /// Most neighbours any particle had in the last step (before the cap).
     pub max_neighbours_found: u32,
-    /// Time in hashing + sorting + rearranging, neighbour search, and density + forces.
+    /// Time hashing: positions and velocities read from the strands, cells and buckets.
+    pub time_hash: Duration,
+    /// Time in the counting sort and rearranging into the sorted order.
     pub time_sort: Duration,
-    /// Time in the neighbour search.
+    /// Time in the neighbour search, with density and pressure.
     pub time_neighbours: Duration,
-    /// Time in density, pressure, viscosity and write-back.
+    /// Time in the pressure and viscosity forces and the write-back.
     pub time_forces: Duration,
 }
 
@@ -121,6 +127,16 @@ pub struct Sph {
     node: Vec<u32>,
     /// Mass of each particle, kg.
     mass: Vec<f32>,
+    /// First particle of each strand, and one past the last strand's.
+    first: Vec<u32>,
+    /// Positions, unsorted order.
+    position: Vec<Vec3>,
+    /// Velocities, unsorted order.
+    velocity: Vec<Vec3>,
+    /// Cell of each particle, unsorted order.
+    cell: Vec<[i32; 3]>,
+    /// Bucket of each particle, unsorted order.
+    bucket: Vec<u32>,
     grid: grid::Grid,
     sorted: forces::SortedParticles,
     neighbours: neighbours::NeighbourLists,
@@ -134,18 +150,22 @@ impl Sph {
     pub fn new<const N: usize>(params: SphParams, strands: &[Strand<N>]) -> Result<Sph, String> {
         params.validate()?;
         let count: usize = strands.iter().map(|s| s.nodes()).sum();
+        u32::try_from(strands.len() * N).map_err(|_| "too many nodes for SPH")?;
         let mut slot = Vec::with_capacity(count);
         let mut strand_of = Vec::with_capacity(count);
         let mut node_of = Vec::with_capacity(count);
         let mut mass = Vec::with_capacity(count);
+        let mut first = Vec::with_capacity(strands.len() + 1);
         for (s, strand) in strands.iter().enumerate() {
+            first.push(slot.len() as u32);
             for i in 0..strand.nodes() {
-                slot.push(u32::try_from(s * N + i).map_err(|_| "too many nodes for SPH")?);
+                slot.push((s * N + i) as u32);
                 strand_of.push(s as u32);
                 node_of.push(i as u32);
                 mass.push(strand.rest.mass[i]);
             }
         }
+        first.push(slot.len() as u32);
         Ok(Sph {
             params,
             grid: grid::Grid::new(count, params.smoothing_length),
@@ -155,6 +175,11 @@ impl Sph {
             strand: strand_of,
             node: node_of,
             mass,
+            first,
+            position: vec![Vec3::ZERO; count],
+            velocity: vec![Vec3::ZERO; count],
+            cell: vec![[0; 3]; count],
+            bucket: vec![0; count],
             stats: SphStats::default(),
         })
     }
@@ -171,10 +196,12 @@ impl Sph {
         self.slot.len()
     }
 
-    /// Computes the SPH accelerations of every node of `strands`, for a step of `dt` seconds
-    /// (the viscosity is linearly implicit in it), into `accelerations`
-    /// (`strands.len() · N` entries, node `i` of strand `s` at `s · N + i`; other entries are
-    /// left untouched). Runs on the current rayon pool; the result does not depend on its size.
+    /// Computes the SPH accelerations of every node of `strands` (the strands [`Sph::new`]
+    /// was built for), for a step of `dt` seconds (the viscosity is linearly implicit in it),
+    /// into `accelerations` (`strands.len() · N` entries, node `i` of strand `s` at
+    /// `s · N + i`; other entries are left untouched). Runs on the current rayon pool; the
+    /// result does not depend on its size: every parallel pass writes fixed chunks, each
+    /// entry a function of the inputs alone.
     pub fn accelerations<const N: usize>(
         &mut self,
         strands: &[Strand<N>],
@@ -182,44 +209,101 @@ impl Sph {
         accelerations: &mut [Vec3],
     ) {
         let t0 = Instant::now();
-        // Algorithm 1, lines 2–4: hash into cells of size h, stable counting sort by bucket.
-        let grid = &mut self.grid;
-        grid.hash_and_sort(self.slot.len(), |p| {
-            strands[self.strand[p] as usize].state.position[self.node[p] as usize]
-        });
-        // Line 5: rearrange into the sorted order.
-        self.sorted.gather(&grid.order, |p| {
-            let s = &strands[self.strand[p] as usize];
-            let i = self.node[p] as usize;
-            (
-                s.state.position[i],
-                s.state.velocity[i],
-                self.mass[p],
-                self.strand[p],
-                self.node[p],
-            )
-        });
+        // Algorithm 1, line 2: read every node and hash it into a cell of size h.
+        let (inverse_cell, row_mask) = (self.grid.inverse_cell(), self.grid.row_mask());
+        let (strand, node) = (&self.strand, &self.node);
+        (
+            self.position.par_chunks_mut(CHUNK),
+            self.velocity.par_chunks_mut(CHUNK),
+            self.cell.par_chunks_mut(CHUNK),
+            self.bucket.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (position, velocity, cell, bucket))| {
+                for k in 0..position.len() {
+                    let p = c * CHUNK + k;
+                    let (s, i) = (strand[p] as usize, node[p] as usize);
+                    let (x, v) = strands.get(s).map_or((Vec3::ZERO, Vec3::ZERO), |s| {
+                        (s.state.position[i], s.state.velocity[i])
+                    });
+                    position[k] = x;
+                    velocity[k] = v;
+                    cell[k] = grid::cell_of(x, inverse_cell);
+                    bucket[k] = grid::bucket_of(cell[k], row_mask);
+                }
+            });
         let t1 = Instant::now();
-        // Line 6: capped neighbour lists.
-        let found = self.neighbours.build(grid, &self.sorted, &self.params);
+        // Lines 3–4: stable counting sort by bucket.
+        self.grid.sort(&self.bucket);
+        // Line 5: rearrange into the sorted order.
+        self.gather();
         let t2 = Instant::now();
-        // Lines 7–9: density, pressure, viscosity.
-        forces::density_and_pressure(&mut self.sorted, &self.neighbours, &self.params);
+        // Lines 6–7: capped neighbour lists, density and pressure.
+        let found = self
+            .neighbours
+            .build(&self.grid, &mut self.sorted, &self.params);
+        let t3 = Instant::now();
+        // Lines 8–9: pressure and viscosity forces.
         forces::accelerations(&mut self.sorted, &self.neighbours, &self.params, dt);
         // Lines 10–11: back to the unsorted order, as per-node accelerations.
-        for (k, &p) in grid.order.iter().enumerate() {
-            if let Some(a) = accelerations.get_mut(self.slot[p as usize] as usize) {
-                *a = self.sorted.acceleration[k];
-            }
-        }
-        let t3 = Instant::now();
+        let (first, rank, sorted) = (&self.first, &self.grid.rank, &self.sorted.acceleration);
+        accelerations
+            .par_chunks_mut(STRANDS_PER_CHUNK * N)
+            .enumerate()
+            .for_each(|(c, out)| {
+                for (k, slots) in out.chunks_mut(N).enumerate() {
+                    let s = c * STRANDS_PER_CHUNK + k;
+                    let (Some(&start), Some(&end)) = (first.get(s), first.get(s + 1)) else {
+                        return;
+                    };
+                    for (a, p) in slots.iter_mut().zip(start..end) {
+                        *a = sorted[rank[p as usize] as usize];
+                    }
+                }
+            });
+        let t4 = Instant::now();
         self.stats.runs += 1;
         self.stats.truncated += found.truncated;
         self.stats.neighbours += found.kept;
         self.stats.max_neighbours_found = found.max_found;
-        self.stats.time_sort += t1 - t0;
-        self.stats.time_neighbours += t2 - t1;
-        self.stats.time_forces += t3 - t2;
+        self.stats.time_hash += t1 - t0;
+        self.stats.time_sort += t2 - t1;
+        self.stats.time_neighbours += t3 - t2;
+        self.stats.time_forces += t4 - t3;
+    }
+
+    /// Fills the sorted arrays from the unsorted ones (sorted slot `k` from particle
+    /// `order[k]`).
+    fn gather(&mut self) {
+        let order = &self.grid.order;
+        let (position, velocity, cell) = (&self.position, &self.velocity, &self.cell);
+        let (mass, strand, node) = (&self.mass, &self.strand, &self.node);
+        let s = &mut self.sorted;
+        (
+            s.x.par_chunks_mut(CHUNK),
+            s.y.par_chunks_mut(CHUNK),
+            s.z.par_chunks_mut(CHUNK),
+            s.velocity.par_chunks_mut(CHUNK),
+            s.mass.par_chunks_mut(CHUNK),
+            s.strand.par_chunks_mut(CHUNK),
+            s.node.par_chunks_mut(CHUNK),
+            s.cell.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (x, y, z, v, m, st, nd, ce))| {
+                for k in 0..x.len() {
+                    let p = order[c * CHUNK + k] as usize;
+                    let q = position[p];
+                    (x[k], y[k], z[k]) = (q.x, q.y, q.z);
+                    v[k] = velocity[p];
+                    m[k] = mass[p];
+                    st[k] = strand[p];
+                    nd[k] = node[p];
+                    ce[k] = cell[p];
+                }
+            });
     }
 }
 

@@ -1,13 +1,19 @@
-//! Capped neighbour lists (Sánchez-Banderas 2015, Sec. 4, Algorithm 1 line 6): the paper's
-//! rough k-nearest list. For each particle, in sorted order, the 27 cells around it are
-//! scanned — its own bucket first, then the other buckets in ascending order, each once — and
-//! the first `cap` particles within `h` are kept. The order is a function of the positions
-//! only, so lists (and truncation) are the same on any number of threads.
+//! Capped neighbour lists (Sánchez-Banderas 2015, Sec. 4, Algorithm 1 line 6: the paper's
+//! rough k-nearest list), with the density and pressure of each particle (line 7) taken in
+//! the same pass, while the distances are at hand.
+//!
+//! Particles of one cell are consecutive in the sorted order and share the ranges of the 27
+//! cells around them ([`Grid::ranges_around`], computed once per such run). For each particle
+//! the candidates of each range — contiguous in the sorted structure-of-arrays positions — are
+//! tested eight at a time for `r² < h²` (no square root), and the first `cap` that pass (and
+//! are not the particle itself nor its own strand's near nodes) are kept, in scan order. The
+//! order is a function of the positions only, so lists, truncation and every sum over a list
+//! are the same on any number of threads.
 
 use rayon::prelude::*;
 
-use super::forces::SortedParticles;
-use super::grid::{bucket_of, cell_of, Grid};
+use super::forces::{poly6_factor, SortedParticles};
+use super::grid::Grid;
 use super::{SphParams, CHUNK};
 
 /// One list of at most `cap` neighbours per particle, in sorted indices.
@@ -41,6 +47,13 @@ impl Found {
     }
 }
 
+/// What the search needs for one particle.
+struct Particle {
+    x: [f32; 3],
+    strand: u32,
+    node: u32,
+}
+
 impl NeighbourLists {
     /// Lists for `particles` particles of at most `cap` neighbours each.
     #[must_use]
@@ -59,25 +72,92 @@ impl NeighbourLists {
         &self.list[a * self.cap..a * self.cap + self.count[a] as usize]
     }
 
-    /// Rebuilds every list from the sorted particles.
-    pub fn build(&mut self, grid: &Grid, particles: &SortedParticles, params: &SphParams) -> Found {
+    /// Rebuilds every list from the sorted particles, and writes each particle's density and
+    /// pressure (`p.density`, `p.pressure`) and its packed force inputs (`p.packed`).
+    pub fn build(&mut self, grid: &Grid, p: &mut SortedParticles, params: &SphParams) -> Found {
         let cap = self.cap;
-        let n = particles.position.len();
-        let h2 = params.smoothing_length * params.smoothing_length;
+        let n = p.x.len();
+        let h = params.smoothing_length;
+        let h2 = h * h;
+        let c6 = poly6_factor(h);
+        let (stiffness, rest) = (params.stiffness, params.rest_density);
+        let gap = params.same_strand_gap;
+        let SortedParticles {
+            x,
+            y,
+            z,
+            velocity,
+            mass,
+            strand,
+            node,
+            cell,
+            density,
+            pressure,
+            packed,
+            ..
+        } = p;
+        let (x, y, z, mass, strand, node, cell, velocity) = (
+            &x[..],
+            &y[..],
+            &z[..],
+            &mass[..],
+            &strand[..],
+            &node[..],
+            &cell[..],
+            &velocity[..],
+        );
         self.list[..n * cap]
             .par_chunks_mut(CHUNK * cap)
             .zip(self.count[..n].par_chunks_mut(CHUNK))
+            .zip(density.par_chunks_mut(CHUNK))
+            .zip(pressure.par_chunks_mut(CHUNK))
+            .zip(packed.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(c, (list, count))| {
+            .map(|(c, ((((list, count), density), pressure), packed))| {
                 let mut found = Found::default();
-                for (k, slot) in count.iter_mut().enumerate() {
+                let mut ranges = ([(0u32, 0u32); 18], 0usize);
+                for k in 0..count.len() {
                     let a = c * CHUNK + k;
+                    // A new run of one cell: its ranges (the run shares them).
+                    if k == 0 || cell[a] != cell[a - 1] {
+                        ranges = grid.ranges_around(cell[a]);
+                    }
+                    let me = Particle {
+                        x: [x[a], y[a], z[a]],
+                        strand: strand[a],
+                        node: node[a],
+                    };
                     let mine = &mut list[k * cap..(k + 1) * cap];
-                    let (kept, all) = neighbours_of(a, grid, particles, params, h2, mine);
-                    *slot = kept;
-                    found.kept += u64::from(kept);
-                    found.truncated += u64::from(all - kept);
+                    let mut kept = 0usize;
+                    let mut all = 0u32;
+                    // ρ / (315/(64π h⁹)): own mass, then the kept neighbours in list order.
+                    let mut sum = mass[a] * h2 * h2 * h2;
+                    for &(s, e) in &ranges.0[..ranges.1] {
+                        scan(s as usize, e as usize, &me, h2, (x, y, z), |j, d2| {
+                            if j == a
+                                || (strand[j] == me.strand && node[j].abs_diff(me.node) <= gap)
+                            {
+                                return;
+                            }
+                            all += 1;
+                            if kept < cap {
+                                mine[kept] = j as u32;
+                                kept += 1;
+                                let w = h2 - d2;
+                                sum += mass[j] * (w * w * w);
+                            }
+                        });
+                    }
+                    count[k] = kept as u32;
+                    found.kept += kept as u64;
+                    found.truncated += u64::from(all) - kept as u64;
                     found.max_found = found.max_found.max(all);
+                    let rho = c6 * sum;
+                    let pr = (stiffness * (rho - rest)).max(0.0);
+                    density[k] = rho;
+                    pressure[k] = pr;
+                    let v = velocity[a];
+                    packed[k] = [me.x[0], me.x[1], me.x[2], mass[a] / rho, v.x, v.y, v.z, pr];
                 }
                 found
             })
@@ -85,72 +165,42 @@ impl NeighbourLists {
     }
 }
 
-/// The buckets of the 27 cells around `cell`, own bucket first, each bucket once.
-fn buckets_around(cell: [i32; 3], mask: u32) -> ([u32; 27], usize) {
-    let own = bucket_of(cell, mask);
-    let mut others = [0u32; 26];
-    let mut n = 0;
-    for dx in -1..=1 {
-        for dy in -1..=1 {
-            for dz in -1..=1 {
-                let b = bucket_of([cell[0] + dx, cell[1] + dy, cell[2] + dz], mask);
-                if b != own {
-                    others[n] = b;
-                    n += 1;
-                }
-            }
-        }
-    }
-    let others = &mut others[..n];
-    others.sort_unstable();
-    let mut out = [own; 27];
-    let mut m = 1;
-    for (i, &b) in others.iter().enumerate() {
-        if i == 0 || b != others[i - 1] {
-            out[m] = b;
-            m += 1;
-        }
-    }
-    (out, m)
-}
-
-/// Fills `out` with the first neighbours of sorted particle `a`; returns (kept, found).
-fn neighbours_of(
-    a: usize,
-    grid: &Grid,
-    particles: &SortedParticles,
-    params: &SphParams,
+/// Calls `hit(j, r²)` for every sorted particle `j` in `s .. e` with `r² < h2`, in order. The
+/// distance test runs on blocks of eight (vectorised), the calls only for the hits.
+#[inline(always)]
+fn scan(
+    s: usize,
+    e: usize,
+    me: &Particle,
     h2: f32,
-    out: &mut [u32],
-) -> (u32, u32) {
-    let x = particles.position[a];
-    let strand = particles.strand[a];
-    let node = particles.node[a];
-    let (buckets, count) = buckets_around(cell_of(x, grid.inverse_cell()), grid.mask());
-    let mut kept = 0usize;
-    let mut found = 0u32;
-    for &b in &buckets[..count] {
-        let range = grid.bucket_start[b as usize]..grid.bucket_start[b as usize + 1];
-        for j in range {
-            let j = j as usize;
-            if j == a {
-                continue;
-            }
-            let d = x - particles.position[j];
-            if d.dot(d) >= h2 {
-                continue;
-            }
-            if particles.strand[j] == strand
-                && particles.node[j].abs_diff(node) <= params.same_strand_gap
-            {
-                continue;
-            }
-            found += 1;
-            if kept < out.len() {
-                out[kept] = j as u32;
-                kept += 1;
-            }
+    (x, y, z): (&[f32], &[f32], &[f32]),
+    mut hit: impl FnMut(usize, f32),
+) {
+    let (x, y, z) = (&x[s..e], &y[s..e], &z[s..e]);
+    let [xa, ya, za] = me.x;
+    let d2 = |i: usize| {
+        let (dx, dy, dz) = (xa - x[i], ya - y[i], za - z[i]);
+        dx * dx + dy * dy + dz * dz
+    };
+    let blocks = x.len() / 8;
+    for b in 0..blocks {
+        let o = b * 8;
+        let (bx, by, bz) = (&x[o..o + 8], &y[o..o + 8], &z[o..o + 8]);
+        let mut mask = 0u32;
+        for l in 0..8 {
+            let (dx, dy, dz) = (xa - bx[l], ya - by[l], za - bz[l]);
+            mask |= u32::from(dx * dx + dy * dy + dz * dz < h2) << l;
+        }
+        while mask != 0 {
+            let l = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            hit(s + o + l, d2(o + l));
         }
     }
-    (kept as u32, found)
+    for i in blocks * 8..x.len() {
+        let r2 = d2(i);
+        if r2 < h2 {
+            hit(s + i, r2);
+        }
+    }
 }

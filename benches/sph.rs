@@ -1,0 +1,170 @@
+//! Vertex-steps per second of whole harness steps (`hairsim::sim::Sim`) on the sizes of
+//! Sánchez-Banderas 2015 Table 1 — Mannequin A and B (the built-in scenes), and scalps with the
+//! strand and vertex counts of Horse Louis, Bunny and Hectroll — for DFTL, DFTL + shape and
+//! DFTL + shape + hair–hair, on one and two threads, with the split of the SPH stage's time among
+//! hash, sort (counting sort + rearranging), neighbour search (with density) and forces.
+//!
+//! Each configuration runs `WARM_UP` steps (the hair leaves its combed start and the neighbour
+//! lists reach their working size), then times `STEPS` steps by the wall clock and by the
+//! process's CPU time (`/proc/self/stat`; on a shared machine the CPU figure is the steadier).
+//!
+//! `cargo bench -p hairsim-benches --bench sph` (all sizes), or with a filter on the scene
+//! name: `cargo bench -p hairsim-benches --bench sph -- mannequin-a`. Under
+//! `cargo test --benches` each configuration of the two smallest sizes runs two steps.
+
+use std::time::{Duration, Instant};
+
+use hairsim::scene::{HairSpec, Prepared, Scene};
+use hairsim::sim::{scene_inputs, Sim, StepInputs};
+use hairsim_core::DefaultMath;
+
+/// Steps before timing (0.5 s of the scene at 1/60 s).
+const WARM_UP: u64 = 30;
+/// Steps timed.
+const STEPS: u64 = 20;
+
+/// CPU seconds used by this process so far (user + system).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|f| f.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+/// A Table 1 size: name, strands, nodes per strand (vertices = strands × nodes; the paper's
+/// count in the comment where it is not a multiple).
+struct Size {
+    name: &'static str,
+    strands: u32,
+    nodes: u32,
+}
+
+const SIZES: &[Size] = &[
+    // 349,232 in the paper: 23.3 a strand.
+    Size {
+        name: "mannequin-a",
+        strands: 15_000,
+        nodes: 23,
+    },
+    Size {
+        name: "mannequin-b",
+        strands: 500,
+        nodes: 16,
+    },
+    // 32,041 in the paper: 9.5 a strand.
+    Size {
+        name: "horse-louis",
+        strands: 3_358,
+        nodes: 10,
+    },
+    Size {
+        name: "bunny",
+        strands: 2_902,
+        nodes: 12,
+    },
+    // 5,710 in the paper: 11.5 a strand.
+    Size {
+        name: "hectroll",
+        strands: 496,
+        nodes: 12,
+    },
+];
+
+/// The mannequin scene (DFTL + shape + hair–hair) with `size`'s strands and nodes, and the
+/// effects of `column`.
+fn scene(size: &Size, column: &str) -> Prepared {
+    let mut scene: Scene = (hairsim::builtin::find("mannequin-a").unwrap().scene)();
+    if let Some(HairSpec::Scalp(scalp)) = &mut scene.hair {
+        scalp.leaders = size.strands;
+        scalp.nodes = size.nodes;
+    }
+    match column {
+        "dftl" => scene.effects.retain(|e| e != "shape" && e != "hair-hair"),
+        "dftl+shape" => scene.effects.retain(|e| e != "hair-hair"),
+        _ => {}
+    }
+    scene.prepare().unwrap()
+}
+
+fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, steps: u64) {
+    let prepared = scene(size, column);
+    let inputs: Vec<StepInputs> = (0..warm_up + steps)
+        .map(|k| scene_inputs::<DefaultMath>(&prepared, k))
+        .collect();
+    let mut sim = Sim::<N, DefaultMath>::new(&prepared, threads).unwrap();
+    let vertices = prepared.nodes();
+    let (wall, cpu, split) = sim.in_pool(|sim| {
+        for i in &inputs[..warm_up as usize] {
+            sim.step(i);
+        }
+        let before = sim.sph.as_ref().map(|s| s.stats.clone());
+        let (cpu0, wall0) = (cpu_seconds(), Instant::now());
+        for i in &inputs[warm_up as usize..] {
+            sim.step(i);
+        }
+        let (wall, cpu) = (wall0.elapsed().as_secs_f64(), cpu_seconds() - cpu0);
+        let split = sim.sph.as_ref().zip(before).map(|(sph, b)| {
+            let s = &sph.stats;
+            let ms = |t: Duration| t.as_secs_f64() * 1e3 / steps as f64;
+            format!(
+                "  sph ms/step: hash {:.2}, sort {:.2}, neighbours {:.2}, forces {:.2}; {:.1} neighbours/node (cap {}, {:.1} dropped/node, most found {})",
+                ms(s.time_hash - b.time_hash),
+                ms(s.time_sort - b.time_sort),
+                ms(s.time_neighbours - b.time_neighbours),
+                ms(s.time_forces - b.time_forces),
+                (s.neighbours - b.neighbours) as f64 / (steps as f64 * vertices as f64),
+                sph.params().neighbour_cap,
+                (s.truncated - b.truncated) as f64 / (steps as f64 * vertices as f64),
+                s.max_neighbours_found,
+            )
+        });
+        (wall, cpu, split)
+    });
+    assert!(sim.is_finite(), "{} {column}: not finite", size.name);
+    let work = vertices as f64 * steps as f64 / 1e6;
+    println!(
+        "{:<12} {:>8} vertices {:<16} {} thread(s): {:>7.2} M vertex-steps/s wall, {:>7.2} M/CPU-s, {:>8.2} ms/step{}",
+        size.name,
+        vertices,
+        column,
+        threads,
+        work / wall,
+        work / cpu.max(0.01),
+        wall * 1e3 / steps as f64,
+        split.unwrap_or_default()
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.iter().any(|a| a == "--list") {
+        return;
+    }
+    // `cargo bench` passes `--bench`; `cargo test --benches` does not: then the two smallest
+    // sizes run two steps each, as a test that the benchmark works, not a measurement.
+    let quick = !args.iter().any(|a| a == "--bench");
+    let filter: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
+    let (warm_up, steps) = if quick { (1, 1) } else { (WARM_UP, STEPS) };
+    for size in SIZES {
+        if quick && size.strands * size.nodes > 10_000 {
+            continue;
+        }
+        if !filter.is_empty() && !filter.iter().any(|f| size.name.contains(f.as_str())) {
+            continue;
+        }
+        for column in ["dftl", "dftl+shape", "dftl+shape+hair-hair"] {
+            for threads in [1, 2] {
+                match size.nodes {
+                    0..=16 => run::<16>(size, column, threads, warm_up, steps),
+                    _ => run::<32>(size, column, threads, warm_up, steps),
+                }
+            }
+        }
+    }
+}
