@@ -115,7 +115,7 @@ pub enum Command {
         /// Fewer values per knob and a shorter run (seconds, not minutes).
         #[arg(long)]
         quick: bool,
-        /// Only this knob (repeatable): dt, iterations, tolerance, twist, solver, nodes, math, s_d.
+        /// Only this knob (repeatable): dt, dt-other (the other solver's dt), iterations, tolerance, twist, solver, nodes, math, s_d.
         #[arg(long = "knob", value_name = "KNOB")]
         knobs: Vec<String>,
         /// Also name the most accurate configuration whose measured cost per simulated

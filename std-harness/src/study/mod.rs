@@ -46,6 +46,8 @@ pub enum Knob {
     Baseline,
     /// The time step, 0.25 to 4 ms.
     TimeStep,
+    /// The time step of the other solver (DFTL for a rod scene, the rod for a DFTL scene).
+    OtherSolverTimeStep,
     /// The fast manifold projection's iteration cap (rod).
     IterationCap,
     /// The projection's tolerance, converge mode (rod).
@@ -64,8 +66,9 @@ pub enum Knob {
 
 impl Knob {
     /// Every knob a sweep can vary, in the order of the table.
-    pub const SWEPT: [Knob; 8] = [
+    pub const SWEPT: [Knob; 9] = [
         Knob::TimeStep,
+        Knob::OtherSolverTimeStep,
         Knob::IterationCap,
         Knob::Tolerance,
         Knob::Twist,
@@ -81,6 +84,7 @@ impl Knob {
         match self {
             Knob::Baseline => "baseline",
             Knob::TimeStep => "dt",
+            Knob::OtherSolverTimeStep => "dt-other",
             Knob::IterationCap => "iterations",
             Knob::Tolerance => "tolerance",
             Knob::Twist => "twist",
@@ -190,6 +194,7 @@ impl Config {
         match self.knob {
             Knob::Baseline => "scene".into(),
             Knob::TimeStep => format!("{} ms", ms(self.dt)),
+            Knob::OtherSolverTimeStep => format!("{} {} ms", self.solver.name(), ms(self.dt)),
             Knob::IterationCap => format!("{}", self.projection_iterations),
             Knob::Tolerance => format!("{:e}", self.projection_tolerance),
             Knob::Twist => self.twist.name().into(),
@@ -381,7 +386,14 @@ impl Plan {
         let mut out = vec![base];
         for &knob in &self.knobs {
             let mut from = base;
-            if let Some(solver) = knob.solver() {
+            let solver = match knob {
+                Knob::OtherSolverTimeStep => Some(match base.solver {
+                    Solver::Rod => Solver::Dftl,
+                    Solver::Dftl => Solver::Rod,
+                }),
+                _ => knob.solver(),
+            };
+            if let Some(solver) = solver {
                 if solver != from.solver && solver == Solver::Rod {
                     // The rod variant of a DFTL scene twists as the reference does: the
                     // hair-optimised twist is a knob of its own.
@@ -399,10 +411,12 @@ impl Plan {
         let q = self.quick;
         match knob {
             Knob::Baseline => vec![from],
-            Knob::TimeStep => pick(q, &[0.25e-3, 0.5e-3, 1e-3, 2e-3, 4e-3], &[0.5e-3, 2e-3])
-                .into_iter()
-                .map(|dt| Config { dt, ..from })
-                .collect(),
+            Knob::TimeStep | Knob::OtherSolverTimeStep => {
+                pick(q, &[0.25e-3, 0.5e-3, 1e-3, 2e-3, 4e-3], &[0.5e-3, 2e-3])
+                    .into_iter()
+                    .map(|dt| Config { dt, ..from })
+                    .collect()
+            }
             Knob::IterationCap => pick(q, &[1u16, 2, 4, 8, 16, 32], &[1, 8])
                 .into_iter()
                 .map(|projection_iterations| Config {

@@ -203,9 +203,15 @@ pub fn plot(study: &Study, path: &Path) -> Result<()> {
             .filter(|r| r.config.knob == *knob)
             .map(|r| (r.us_per_ms, r.rms_distance))
             .collect();
-        let label = match knob.solver() {
-            Some(s) => format!("{} ({})", knob.name(), s.name()),
-            None => knob.name().to_string(),
+        // The solver the curve runs, when it is not the scene's.
+        let label = match finite
+            .iter()
+            .find(|r| r.config.knob == *knob && r.config.solver != study.solver)
+        {
+            Some(r) if *knob != Knob::Solver => {
+                format!("{} ({})", knob.name(), r.config.solver.name())
+            }
+            _ => knob.name().to_string(),
         };
         chart
             .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))
