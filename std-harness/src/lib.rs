@@ -18,6 +18,7 @@ pub mod run;
 pub mod scene;
 pub mod sim;
 pub mod sph;
+pub mod study;
 pub mod summary;
 
 pub use hairsim_core as core;

@@ -4,6 +4,7 @@ pub mod check;
 pub mod replay;
 pub mod run;
 pub mod scenes;
+pub mod study;
 
 use std::path::PathBuf;
 
@@ -95,6 +96,33 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Sweep one knob at a time (time step, projection cap and tolerance, twist, solver,
+    /// nodes, math backend, s_d) and measure each configuration's step time against its error
+    /// from a converged reference; writes DIR/SCENE.md, .csv and .svg.
+    #[command(
+        after_help = "Examples:\n  hairsim study firmware --out docs/study\n  hairsim study firmware-dftl --quick\n  hairsim study firmware --knob dt --knob math --budget-us 1000"
+    )]
+    Study {
+        /// A built-in scene name or a TOML scene file (default: the built-in default scene).
+        #[arg(default_value = crate::builtin::DEFAULT_SCENE)]
+        scene: String,
+        /// Folder for SCENE.md, SCENE.csv and SCENE.svg.
+        #[arg(long, default_value = "study")]
+        out: PathBuf,
+        /// Simulated time of every run, s (default 1, or 0.2 with --quick).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Fewer values per knob and a shorter run (seconds, not minutes).
+        #[arg(long)]
+        quick: bool,
+        /// Only this knob (repeatable): dt, dt-other (the other solver's dt), iterations, tolerance, twist, solver, nodes, math, s_d.
+        #[arg(long = "knob", value_name = "KNOB")]
+        knobs: Vec<String>,
+        /// Also name the most accurate configuration whose measured cost per simulated
+        /// millisecond fits B microseconds (1000 = a 1 kHz loop's whole tick).
+        #[arg(long, value_name = "B")]
+        budget_us: Option<f64>,
+    },
 }
 
 /// The machine's cores (1 if it cannot tell).
@@ -144,5 +172,20 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<String> {
             threads,
             json,
         } => replay::replay(&file, threads, json),
+        Command::Study {
+            scene,
+            out,
+            duration,
+            quick,
+            knobs,
+            budget_us,
+        } => study::study(&study::Args {
+            scene,
+            out,
+            duration,
+            quick,
+            knobs,
+            budget_us,
+        }),
     }
 }
