@@ -317,13 +317,8 @@ fn solve_and_move<M: Math, const N: usize>(
     let first = work.rows.first();
     let count = rows.len();
     let band = work.band.get_mut(..count)?;
-    banded::assemble(rows, first, &work.nodes.inverse_mass, band);
-    dropped += banded::factor(band, first);
     let multipliers = work.multipliers.get_mut(..count)?;
-    for (lambda, row) in multipliers.iter_mut().zip(rows) {
-        *lambda = row.rhs;
-    }
-    banded::solve(band, first, multipliers);
+    dropped += banded::solve_chain(rows, first, &work.nodes.inverse_mass, band, multipliers);
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
@@ -340,9 +335,11 @@ fn solve_and_move<M: Math, const N: usize>(
             }
         }
     }
+    let mut any_contact = false;
     for (dx, contacts) in step.iter_mut().zip(work.rows.contacts.iter()).take(n) {
         if contacts.kept > 0 {
             *dx -= contacts.displacement;
+            any_contact = true;
         }
     }
     // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
@@ -372,8 +369,9 @@ fn solve_and_move<M: Math, const N: usize>(
     for (x, dx) in strand.state.position.iter_mut().zip(step.iter()).take(n) {
         *x += *dx * scale;
     }
-    // Forces from the multipliers actually applied (`scale · δλ`).
-    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
+    // Forces from the multipliers actually applied (`scale · δλ`): only for held grabs.
+    let grabbed = if held.is_empty() { &[] } else { rows };
+    for (row, &lambda) in grabbed.iter().zip(multipliers.iter()) {
         for (&node, &gradient) in row.nodes.iter().zip(row.gradient.iter()) {
             let i = usize::from(node);
             if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
@@ -381,7 +379,9 @@ fn solve_and_move<M: Math, const N: usize>(
             }
         }
     }
-    for i in 0..n {
+    // Collider forces: only where a node kept a contact row this iteration.
+    let contact_nodes = if any_contact { n } else { 0 };
+    for i in 0..contact_nodes {
         let contacts = work.rows.contacts[i];
         if contacts.kept == 0 {
             continue;
