@@ -60,13 +60,18 @@ fn params(solver: Solver) -> Params {
             Effect::Shape,
         ]),
     };
-    Params {
+    let mut params = Params {
         solver,
         effects,
         mode: Mode::FixedCost,
         drag: 2.0e-7,
         ..Params::DEFAULT
-    }
+    };
+    // The rod's projection cap is what these scenes need to meet the 1e-6 tolerance: in
+    // converge mode, calm steps take 1 iteration and violent ones 1–3 (measured on the host
+    // over 1000 steps of 4 × 32 nodes), so 4 keeps one in hand.
+    params.rod.projection_iterations = 4;
+    params
 }
 
 /// Fills `world` with `strands` strands of `nodes` nodes (1 cm segments) rooted around a 5 cm
