@@ -376,10 +376,15 @@ pub fn evaluate<M: Math, const N: usize>(
         if nodes.is_free(i) || nodes.is_free(i + 1) {
             let row = Row::segment(i, x[i], x[i + 1], rest_length[i]);
             let rest2 = rest_length[i] * rest_length[i];
-            let relative = row.value.abs() / rest2;
-            // `max` would drop a NaN: keep it visible in the residual.
-            if relative.is_nan() || relative > rows.residual {
-                rows.residual = relative;
+            // `max` would drop a NaN: keep it visible in the residual. Compared multiplied
+            // out, so the division runs only for a new largest row (a few per iterate, not
+            // one per segment: VDIV is 14 cycles on a Cortex-M4F).
+            let magnitude = row.value.abs();
+            if magnitude > rows.residual * rest2 || magnitude.is_nan() {
+                let relative = magnitude / rest2;
+                if relative.is_nan() || relative > rows.residual {
+                    rows.residual = relative;
+                }
             }
             // The resolution floor only matters while every row so far is met.
             if rows.converged && row.value.abs() > tolerance * rest2 {

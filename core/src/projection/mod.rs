@@ -323,25 +323,10 @@ fn solve_and_move<M: Math, const N: usize>(
         return None;
     }
     // Δx: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact),
-    // contacts by −d_i.
-    let step = &mut work.step;
-    *step = [Vec3::ZERO; N];
-    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
-        for (&node, &projected) in row.nodes.iter().zip(row.projected.iter()) {
-            let i = usize::from(node);
-            let w = work.nodes.inverse_mass.get(i).copied().unwrap_or(0.0);
-            if let (true, Some(dx)) = (w > 0.0, step.get_mut(i)) {
-                *dx -= projected * (w * lambda);
-            }
-        }
-    }
-    let mut any_contact = false;
-    for (dx, contacts) in step.iter_mut().zip(work.rows.contacts.iter()).take(n) {
-        if contacts.kept > 0 {
-            *dx -= contacts.displacement;
-            any_contact = true;
-        }
-    }
+    // contacts by −d_i. Gathered per node from its two segments (segment i − 1 first, as the
+    // rows are in segment order), with the longest move for the trust region below in the
+    // same pass.
+    //
     // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
     // asks for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled
     // down whole (its direction kept): garbage then converges slowly instead of exploding.
@@ -349,14 +334,40 @@ fn solve_and_move<M: Math, const N: usize>(
     // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
     // the next ones converged; a radius of one strand length cut that short and broke the
     // iteration. Hence ten strand lengths.
+    let mut any_contact = false;
     let mut longest2: Real = 0.0;
-    for dx in step.iter().take(n) {
-        let d2 = dx.dot(*dx);
+    let segment_row = &work.rows.segment_row;
+    let nodes = work
+        .step
+        .iter_mut()
+        .zip(work.nodes.inverse_mass.iter())
+        .zip(work.rows.contacts.iter())
+        .enumerate()
+        .take(n);
+    for (i, ((dx, &w), contacts)) in nodes {
+        let mut delta = Vec3::ZERO;
+        if w > 0.0 {
+            for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+                let r = segment_row
+                    .get(segment)
+                    .map_or(usize::MAX, |&r| usize::from(r));
+                if let (Some(row), Some(&lambda)) = (rows.get(r), multipliers.get(r)) {
+                    delta -= row.projected[block] * (w * lambda);
+                }
+            }
+        }
+        if contacts.kept > 0 {
+            delta -= contacts.displacement;
+            any_contact = true;
+        }
+        let d2 = delta.dot(delta);
         // Not `max`, which would drop a NaN.
         if d2.is_nan() || d2 > longest2 {
             longest2 = d2;
         }
+        *dx = delta;
     }
+    let step = &work.step;
     if !longest2.is_finite() {
         return None;
     }
