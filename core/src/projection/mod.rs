@@ -132,6 +132,7 @@ pub fn project_constraints<M: Math, const N: usize>(
             0
         },
         fixed_cost: ctx.params.mode == Mode::FixedCost,
+        residual_only: false,
     };
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
     let mut outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
@@ -275,6 +276,11 @@ fn iterate<M: Math, const N: usize>(
     let tolerance = ctx.params.rod.projection_tolerance;
     let mut outcome = Outcome::default();
     for k in 0..=cap {
+        // After the last solve only the residual is wanted: no rows.
+        let layout = Layout {
+            residual_only: k == cap,
+            ..layout
+        };
         constraints::evaluate::<M, N>(
             strand,
             &work.nodes,
