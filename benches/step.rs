@@ -1,8 +1,88 @@
-//! The firmware scene's step, as a first benchmark of the real step path.
+//! Kmoch 2009 Table 1: ms per full rod step of the papers' scenes (the harness's built-in
+//! `stand-1` … `stand-3`, `head-1` … `head-3`: leaders only, one thread), plus the firmware
+//! scene's step.
+//!
+//! A settled scene converges in no iterations and proves nothing, so every scene is measured
+//! in motion: the heads shake at 10 rad/s, and so do the stands (they start horizontal and
+//! would otherwise settle while criterion samples). Each scene is
+//! first run `WARM_UP_STEPS` steps (the hair is swinging by then), then criterion times the
+//! next steps one at a time (state carried on, never reset: each sample is a step of the
+//! moving scene). The projection iterations of those steps (mean and max per strand) are
+//! printed once per scene, since converge mode's cost follows them.
+//!
+//! Goals (issue 4): Head #1 ≤ 0.25 ms per step, Stand #1 ≤ 0.015 ms, on one core.
+//! `cargo bench -p hairsim-benches --bench step` (CI's `cargo test --benches` runs each case
+//! once).
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use hairsim::builtin;
+use hairsim::scene::Prepared;
+use hairsim::sim::{scene_inputs, Sim};
 use hairsim_core::scenes::firmware;
 use hairsim_core::{Libm, World};
+
+/// Node capacity of the rod scenes (30 nodes per leader).
+const NODES: usize = 32;
+/// Steps run before measuring: the stands have fallen half-way, the heads swing.
+const WARM_UP_STEPS: u64 = 150;
+/// Steps whose iterations are counted for the printed line.
+const COUNTED_STEPS: u64 = 200;
+
+const SCENES: [&str; 6] = [
+    "stand-1", "stand-2", "stand-3", "head-1", "head-2", "head-3",
+];
+
+/// The built-in scene `name`; the stands (no head of their own) get the heads' 10 rad/s
+/// shake, so that they stay in motion however many steps criterion takes.
+fn prepared(name: &str) -> Prepared {
+    let build = |name| (builtin::find(name).expect("built-in scene").scene)();
+    let mut scene = build(name);
+    if scene.head.is_none() {
+        scene.head = build("head-1").head;
+    }
+    scene.prepare().expect("valid built-in scene")
+}
+
+/// A one-thread simulation of `prepared` after `steps` steps.
+fn warmed_up(prepared: &Prepared, steps: u64) -> Sim<NODES, Libm> {
+    let mut sim = Sim::<NODES, Libm>::new(prepared, 1).expect("scene builds");
+    for k in 0..steps {
+        sim.step(&scene_inputs::<Libm>(prepared, k));
+    }
+    sim
+}
+
+fn rod_table_1(c: &mut Criterion) {
+    let mut group = c.benchmark_group("Kmoch Table 1 (ms per step, leaders, one thread)");
+    for name in SCENES {
+        let prepared = prepared(name);
+        // The iterations the measured steps take (converge mode: cost follows them).
+        let mut probe = warmed_up(&prepared, WARM_UP_STEPS);
+        let strands = probe.strands.len() as u64;
+        let (mut total, mut max) = (0u64, 0u32);
+        for k in WARM_UP_STEPS..WARM_UP_STEPS + COUNTED_STEPS {
+            let report = probe.step(&scene_inputs::<Libm>(&prepared, k));
+            total += u64::from(report.iterations_total);
+            max = max.max(report.iterations_max);
+        }
+        println!(
+            "{name}: {strands} strands, projection iterations per strand-step mean {:.2} max {max} \
+             (steps {WARM_UP_STEPS}..{})",
+            total as f64 / (strands * COUNTED_STEPS) as f64,
+            WARM_UP_STEPS + COUNTED_STEPS
+        );
+        let mut sim = warmed_up(&prepared, WARM_UP_STEPS);
+        let mut k = WARM_UP_STEPS;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let report = sim.step(&scene_inputs::<Libm>(&prepared, k));
+                k += 1;
+                report
+            })
+        });
+    }
+    group.finish();
+}
 
 fn firmware_step(c: &mut Criterion) {
     let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, Libm>> = Box::default();
@@ -17,5 +97,5 @@ fn firmware_step(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, firmware_step);
+criterion_group!(benches, rod_table_1, firmware_step);
 criterion_main!(benches);

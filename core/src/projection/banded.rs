@@ -233,6 +233,96 @@ pub fn solve(band: &[BandRow], first: &[u16], rhs: &mut [Real]) {
     }
 }
 
+/// The projection's own system in one fused pass (the path [`super::project_constraints`]
+/// takes): once each node's collision rows are eliminated ([`eliminate_contacts`]) only the
+/// segment rows are left and `A` is tridiagonal (row `r` couples to `r − 1` at most, when
+/// `first[r] < r`). So assembly, the `L D Lᵀ` factorisation and the forward substitution run
+/// together root → tip, and the back substitution tip → root: two passes over the rows and
+/// no envelope bookkeeping, where [`assemble`], [`factor`] and [`solve`] take four and
+/// handle any half-bandwidth up to [`MAX_HALF_BANDWIDTH`]. Same operations in the same
+/// order as those three on a tridiagonal envelope, so the same bits (a unit test checks it).
+///
+/// On return `multipliers[..rows.len()]` holds `δλ` and `band[r][0]`, `band[r][1]` hold `D_r`
+/// and `L_{r,r−1}`. A pivot that is not clearly positive is dropped as in [`factor`]; returns
+/// how many were.
+pub fn solve_chain(
+    rows: &[Row],
+    first: &[u16],
+    inverse_mass: &[Real],
+    band: &mut [BandRow],
+    multipliers: &mut [Real],
+) -> u32 {
+    let count = rows.len().min(band.len()).min(multipliers.len());
+    let mut dropped = 0;
+    // D and z of the previous row (root → tip).
+    let (mut d_above, mut z_above) = (0.0, 0.0);
+    for r in 0..count {
+        let row = &rows[r];
+        let coupled = r > 0 && first.get(r).is_some_and(|&f| usize::from(f) < r);
+        let (diagonal, below) = if row.kind == RowKind::Padding {
+            (1.0, 0.0)
+        } else {
+            (
+                diagonal_entry(row, inverse_mass),
+                match rows.get(r.wrapping_sub(1)) {
+                    Some(above) if coupled => coupling(row, above, inverse_mass),
+                    _ => 0.0,
+                },
+            )
+        };
+        let mut z = row.rhs;
+        let mut d = diagonal;
+        let mut lower = 0.0;
+        if coupled {
+            lower = if d_above > 0.0 { below / d_above } else { 0.0 };
+            d -= lower * lower * d_above;
+            z -= lower * z_above;
+        }
+        // `!(… > …)` also catches NaN.
+        if !(diagonal > 0.0 && d > PIVOT_RATIO * diagonal && d.is_finite()) {
+            d = 0.0;
+            dropped += 1;
+        }
+        band[r][0] = d;
+        band[r][1] = if coupled { lower } else { 0.0 };
+        multipliers[r] = if d > 0.0 { z / d } else { 0.0 };
+        (d_above, z_above) = (d, z);
+    }
+    // Backward: Lᵀ y = u.
+    for r in (1..count).rev() {
+        let y = multipliers[r];
+        if first.get(r).is_some_and(|&f| usize::from(f) < r) {
+            multipliers[r - 1] -= band[r][1] * y;
+        }
+    }
+    dropped
+}
+
+/// `A_rr` of a segment row: [`product`] of the row with itself, written out.
+#[inline(always)]
+fn diagonal_entry(row: &Row, inverse_mass: &[Real]) -> Real {
+    let w = |node: u16| inverse_mass.get(usize::from(node)).copied().unwrap_or(0.0);
+    let [p0, p1] = row.projected;
+    w(row.nodes[0]) * p0.dot(p0) + w(row.nodes[1]) * p1.dot(p1)
+}
+
+/// `A_{r,r−1}` of consecutive segment rows, which share the node `row.nodes[0] =
+/// above.nodes[1]` (any other pattern goes through [`product`]).
+#[inline(always)]
+fn coupling(row: &Row, above: &Row, inverse_mass: &[Real]) -> Real {
+    let shared = row.nodes[0];
+    let distinct = above.nodes[0] != shared && row.nodes[1] != shared;
+    if shared == above.nodes[1] && row.nodes[1] != above.nodes[0] && distinct {
+        let w = inverse_mass
+            .get(usize::from(shared))
+            .copied()
+            .unwrap_or(0.0);
+        w * row.projected[0].dot(above.projected[1])
+    } else {
+        product(row, above, inverse_mass)
+    }
+}
+
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)] // dense reference code reads best with indices
 mod tests {
@@ -400,5 +490,62 @@ mod tests {
         let mut y = [1.0, 1.0];
         solve(&bad, &first, &mut y);
         assert_eq!(y, [0.0, 0.0]);
+    }
+    #[test]
+    fn the_fused_chain_solve_gives_the_bits_of_assemble_factor_solve() {
+        let mut rng = Rng(0x5eed_cafe);
+        for trial in 0..50 {
+            let n = 3 + trial % 20;
+            let mut x = [Vec3::ZERO; M];
+            let mut w = [0.0 as Real; M];
+            for i in 0..n {
+                let r = |rng: &mut Rng| (rng.next() * 2.0 - 1.0) as Real;
+                x[i] = Vec3::new(
+                    i as Real * 0.01 + 0.002 * r(&mut rng),
+                    0.003 * r(&mut rng),
+                    0.0,
+                );
+                // Some prescribed nodes (w = 0) and some pivots that must be dropped.
+                w[i] = if i < 2 || rng.next() < 0.1 {
+                    0.0
+                } else {
+                    1.0 + rng.next() as Real
+                };
+            }
+            let mut rows = [Row::default(); M];
+            let mut first = [0u16; M];
+            let fixed_cost = trial % 2 == 0;
+            for j in 0..n - 1 {
+                if w[j] == 0.0 && w[j + 1] == 0.0 {
+                    first[j] = j as u16; // padding row, no coupling
+                    continue;
+                }
+                rows[j] = Row::segment(j, x[j], x[j + 1], 0.01);
+                let coupled = j > 0 && (fixed_cost || rows[j - 1].kind == RowKind::Segment);
+                first[j] = if coupled { j as u16 - 1 } else { j as u16 };
+            }
+            let count = n - 1;
+            let mut band = [[0.0 as Real; MAX_HALF_BANDWIDTH + 1]; M];
+            assemble(&rows[..count], &first[..count], &w, &mut band[..count]);
+            let dropped = factor(&mut band[..count], &first[..count]);
+            let mut y = [0.0 as Real; M];
+            for r in 0..count {
+                y[r] = rows[r].rhs;
+            }
+            solve(&band[..count], &first[..count], &mut y[..count]);
+            let mut fused_band = [[0.0 as Real; MAX_HALF_BANDWIDTH + 1]; M];
+            let mut fused = [0.0 as Real; M];
+            let fused_dropped = solve_chain(
+                &rows[..count],
+                &first[..count],
+                &w,
+                &mut fused_band[..count],
+                &mut fused[..count],
+            );
+            assert_eq!(fused_dropped, dropped, "trial {trial}");
+            for r in 0..count {
+                assert_eq!(fused[r].to_bits(), y[r].to_bits(), "trial {trial} row {r}");
+            }
+        }
     }
 }

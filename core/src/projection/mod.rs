@@ -132,6 +132,7 @@ pub fn project_constraints<M: Math, const N: usize>(
             0
         },
         fixed_cost: ctx.params.mode == Mode::FixedCost,
+        residual_only: false,
     };
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
     let mut outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
@@ -275,6 +276,11 @@ fn iterate<M: Math, const N: usize>(
     let tolerance = ctx.params.rod.projection_tolerance;
     let mut outcome = Outcome::default();
     for k in 0..=cap {
+        // After the last solve only the residual is wanted: no rows.
+        let layout = Layout {
+            residual_only: k == cap,
+            ..layout
+        };
         constraints::evaluate::<M, N>(
             strand,
             &work.nodes,
@@ -317,34 +323,16 @@ fn solve_and_move<M: Math, const N: usize>(
     let first = work.rows.first();
     let count = rows.len();
     let band = work.band.get_mut(..count)?;
-    banded::assemble(rows, first, &work.nodes.inverse_mass, band);
-    dropped += banded::factor(band, first);
     let multipliers = work.multipliers.get_mut(..count)?;
-    for (lambda, row) in multipliers.iter_mut().zip(rows) {
-        *lambda = row.rhs;
-    }
-    banded::solve(band, first, multipliers);
+    dropped += banded::solve_chain(rows, first, &work.nodes.inverse_mass, band, multipliers);
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
     // Δx: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact),
-    // contacts by −d_i.
-    let step = &mut work.step;
-    *step = [Vec3::ZERO; N];
-    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
-        for (&node, &projected) in row.nodes.iter().zip(row.projected.iter()) {
-            let i = usize::from(node);
-            let w = work.nodes.inverse_mass.get(i).copied().unwrap_or(0.0);
-            if let (true, Some(dx)) = (w > 0.0, step.get_mut(i)) {
-                *dx -= projected * (w * lambda);
-            }
-        }
-    }
-    for (dx, contacts) in step.iter_mut().zip(work.rows.contacts.iter()).take(n) {
-        if contacts.kept > 0 {
-            *dx -= contacts.displacement;
-        }
-    }
+    // contacts by −d_i. Gathered per node from its two segments (segment i − 1 first, as the
+    // rows are in segment order), with the longest move for the trust region below in the
+    // same pass.
+    //
     // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
     // asks for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled
     // down whole (its direction kept): garbage then converges slowly instead of exploding.
@@ -352,14 +340,40 @@ fn solve_and_move<M: Math, const N: usize>(
     // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
     // the next ones converged; a radius of one strand length cut that short and broke the
     // iteration. Hence ten strand lengths.
+    let mut any_contact = false;
     let mut longest2: Real = 0.0;
-    for dx in step.iter().take(n) {
-        let d2 = dx.dot(*dx);
+    let segment_row = &work.rows.segment_row;
+    let nodes = work
+        .step
+        .iter_mut()
+        .zip(work.nodes.inverse_mass.iter())
+        .zip(work.rows.contacts.iter())
+        .enumerate()
+        .take(n);
+    for (i, ((dx, &w), contacts)) in nodes {
+        let mut delta = Vec3::ZERO;
+        if w > 0.0 {
+            for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+                let r = segment_row
+                    .get(segment)
+                    .map_or(usize::MAX, |&r| usize::from(r));
+                if let (Some(row), Some(&lambda)) = (rows.get(r), multipliers.get(r)) {
+                    delta -= row.projected[block] * (w * lambda);
+                }
+            }
+        }
+        if contacts.kept > 0 {
+            delta -= contacts.displacement;
+            any_contact = true;
+        }
+        let d2 = delta.dot(delta);
         // Not `max`, which would drop a NaN.
         if d2.is_nan() || d2 > longest2 {
             longest2 = d2;
         }
+        *dx = delta;
     }
+    let step = &work.step;
     if !longest2.is_finite() {
         return None;
     }
@@ -372,8 +386,9 @@ fn solve_and_move<M: Math, const N: usize>(
     for (x, dx) in strand.state.position.iter_mut().zip(step.iter()).take(n) {
         *x += *dx * scale;
     }
-    // Forces from the multipliers actually applied (`scale · δλ`).
-    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
+    // Forces from the multipliers actually applied (`scale · δλ`): only for held grabs.
+    let grabbed = if held.is_empty() { &[] } else { rows };
+    for (row, &lambda) in grabbed.iter().zip(multipliers.iter()) {
         for (&node, &gradient) in row.nodes.iter().zip(row.gradient.iter()) {
             let i = usize::from(node);
             if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
@@ -381,7 +396,9 @@ fn solve_and_move<M: Math, const N: usize>(
             }
         }
     }
-    for i in 0..n {
+    // Collider forces: only where a node kept a contact row this iteration.
+    let contact_nodes = if any_contact { n } else { 0 };
+    for i in 0..contact_nodes {
         let contacts = work.rows.contacts[i];
         if contacts.kept == 0 {
             continue;
