@@ -25,6 +25,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
+use cpu_time::ThreadTime;
 use criterion::{criterion_group, Criterion};
 use hairsim::run::{load, HairFileOptions};
 use hairsim::scene::Prepared;
@@ -128,10 +129,11 @@ impl Case {
         scene_inputs::<Libm>(&self.prepared, snapshot.steps)
     }
 
-    /// µs of one step from `snapshot`.
+    /// µs of one step from `snapshot`: the thread's CPU time, which stops while the thread is
+    /// descheduled (on a shared machine the wall clock adds other processes' time slices).
     fn step_from(&mut self, snapshot: &Snapshot) -> f64 {
         let inputs = self.restore(snapshot);
-        let start = Instant::now();
+        let start = ThreadTime::now();
         black_box(self.sim.step(black_box(&inputs)));
         start.elapsed().as_secs_f64() * 1e6
     }
@@ -201,15 +203,20 @@ fn table(scene_name: &str, rounds: usize, repeats: usize) {
     let base = scene(scene_name);
     let states = snapshots(&base);
     let mut cases = cases(&base);
+    // Finely interleaved: for each state, every case in turn, so that a change of the
+    // machine's load falls on all cases alike.
     for _ in 0..rounds {
-        for case in &mut cases {
-            let mut round: Vec<f64> = states
-                .iter()
-                .flat_map(|s| std::iter::repeat_n(s, repeats))
-                .map(|s| case.step_from(s))
-                .collect();
-            case.round_medians.push(median(&mut round));
-            case.times.extend(round);
+        let mut round: Vec<Vec<f64>> = vec![Vec::new(); cases.len()];
+        for state in &states {
+            for (case, times) in cases.iter_mut().zip(&mut round) {
+                for _ in 0..repeats {
+                    times.push(case.step_from(state));
+                }
+            }
+        }
+        for (case, mut times) in cases.iter_mut().zip(round) {
+            case.round_medians.push(median(&mut times));
+            case.times.extend(times);
         }
     }
     for case in &mut cases {
@@ -224,23 +231,25 @@ fn table(scene_name: &str, rounds: usize, repeats: usize) {
     };
     let all = med("all");
     let none = med("none");
+    // The noise: the standard deviation of the all-on case's round medians.
     let noise = cases.iter().find(|c| c.name == "all").map_or(0.0, |c| {
-        let lo = c
-            .round_medians
+        let n = c.round_medians.len().max(1) as f64;
+        let mean = c.round_medians.iter().sum::<f64>() / n;
+        (c.round_medians
             .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
-        let hi = c.round_medians.iter().copied().fold(0.0, f64::max);
-        hi - lo
+            .map(|m| (m - mean).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt()
     });
     println!(
-        "\n{scene_name} ({} solver, {} strands, {} nodes): median µs of one step from each of the same {} states, {rounds} rounds of {repeats} per state",
+        "\n{scene_name} ({} solver, {} strands, {} nodes): median thread-CPU µs of one step from each of the same {} states, {rounds} rounds of {repeats} per state",
         base.params.solver.name(),
         base.strands.len(),
         base.nodes(),
         states.len()
     );
-    println!("  all effects on: {all:.2} µs; nothing on: {none:.2} µs; noise (spread of the all-on round medians): {noise:.2} µs");
+    println!("  all effects on: {all:.2} µs; nothing on: {none:.2} µs; noise (standard deviation of the all-on round medians): {noise:.2} µs");
     println!(
         "  {:<16} {:>16} {:>16}",
         "effect", "all − without", "alone − none"
