@@ -4,6 +4,10 @@
 //! each effect turned off in turn. An effect's marginal cost is the step with everything on
 //! minus the step without it; a second column adds it alone to a step with nothing on.
 //!
+//! Every variant is timed stepping from the same 20 states of the all-on run (restored before
+//! each timed step): the rod's substep count follows the strands' bends, so variants left to
+//! run their own trajectories would differ by their states' cost as much as by their code's.
+//!
 //! An effect that is off costs within noise of its code not existing. How that is shown:
 //! * the stages an effect gates report that they did not run (`StepReport::runs` is 0; checked
 //!   below before anything is timed), so none of the effect's code runs, only the test of its
@@ -21,13 +25,14 @@
 use std::hint::black_box;
 use std::time::Instant;
 
+use cpu_time::ThreadTime;
 use criterion::{criterion_group, Criterion};
 use hairsim::run::{load, HairFileOptions};
 use hairsim::scene::Prepared;
 use hairsim::sim::{scene_inputs, Sim, StepInputs};
 use hairsim::sph::SphParams;
 use hairsim_core::context::StepContext;
-use hairsim_core::{Effect, Effects, Libm, Params, Pose, Solver, Stage};
+use hairsim_core::{Effect, Effects, Grab, Libm, Params, Pose, Solver, Stage, Strand};
 
 /// The firmware scenes' strands have at most 16 nodes.
 const N: usize = 16;
@@ -66,12 +71,40 @@ fn gated_stages(effect: Effect, solver: Solver) -> &'static [Stage] {
     }
 }
 
+/// A state of the all-on run to step from: every variant is timed stepping from the same
+/// states, so that a difference is the effect's code, not a different trajectory (the rod's
+/// substep count follows the strands' bends).
+#[derive(Clone)]
+struct Snapshot {
+    steps: u64,
+    head: Pose,
+    strands: Vec<Strand<N>>,
+    grabs: Vec<Grab>,
+}
+
+/// States of the all-on scene every 50 steps over its first second.
+fn snapshots(all_on: &Prepared) -> Vec<Snapshot> {
+    let mut sim = Sim::<N, Libm>::new(all_on, 1).expect("scene builds");
+    let mut out = Vec::new();
+    for k in 0..1000u64 {
+        if k % 50 == 25 {
+            out.push(Snapshot {
+                steps: sim.steps,
+                head: sim.head,
+                strands: sim.strands.clone(),
+                grabs: sim.grabs.clone(),
+            });
+        }
+        sim.step(&scene_inputs::<Libm>(all_on, k));
+    }
+    out
+}
+
 /// One timed variant.
 struct Case {
     name: String,
     sim: Sim<N, Libm>,
     prepared: Prepared,
-    k: u64,
     times: Vec<f64>,
     round_medians: Vec<f64>,
 }
@@ -82,21 +115,25 @@ impl Case {
             name,
             sim: Sim::new(prepared, 1).expect("scene builds"),
             prepared: prepared.clone(),
-            k: 0,
             times: Vec::new(),
             round_medians: Vec::new(),
         }
     }
 
-    /// The next step's inputs (computed outside the timed step).
-    fn inputs(&mut self) -> StepInputs {
-        self.k += 1;
-        scene_inputs::<Libm>(&self.prepared, self.k - 1)
+    /// Puts the variant in the state `snapshot`; the inputs of its next step.
+    fn restore(&mut self, snapshot: &Snapshot) -> StepInputs {
+        self.sim.steps = snapshot.steps;
+        self.sim.head = snapshot.head;
+        self.sim.strands.clone_from(&snapshot.strands);
+        self.sim.grabs.clone_from(&snapshot.grabs);
+        scene_inputs::<Libm>(&self.prepared, snapshot.steps)
     }
 
-    fn step(&mut self) -> f64 {
-        let inputs = self.inputs();
-        let start = Instant::now();
+    /// µs of one step from `snapshot`: the thread's CPU time, which stops while the thread is
+    /// descheduled (on a shared machine the wall clock adds other processes' time slices).
+    fn step_from(&mut self, snapshot: &Snapshot) -> f64 {
+        let inputs = self.restore(snapshot);
+        let start = ThreadTime::now();
         black_box(self.sim.step(black_box(&inputs)));
         start.elapsed().as_secs_f64() * 1e6
     }
@@ -162,14 +199,24 @@ fn check_gated_off(prepared: &Prepared, effect: Effect, solver: Solver) {
 
 /// Times every case in interleaved rounds (a change of the machine's load falls on all alike)
 /// and prints the table.
-fn table(scene_name: &str, rounds: usize, steps_per_round: usize) {
+fn table(scene_name: &str, rounds: usize, repeats: usize) {
     let base = scene(scene_name);
+    let states = snapshots(&base);
     let mut cases = cases(&base);
+    // Finely interleaved: for each state, every case in turn, so that a change of the
+    // machine's load falls on all cases alike.
     for _ in 0..rounds {
-        for case in &mut cases {
-            let mut round: Vec<f64> = (0..steps_per_round).map(|_| case.step()).collect();
-            case.round_medians.push(median(&mut round));
-            case.times.extend(round);
+        let mut round: Vec<Vec<f64>> = vec![Vec::new(); cases.len()];
+        for state in &states {
+            for (case, times) in cases.iter_mut().zip(&mut round) {
+                for _ in 0..repeats {
+                    times.push(case.step_from(state));
+                }
+            }
+        }
+        for (case, mut times) in cases.iter_mut().zip(round) {
+            case.round_medians.push(median(&mut times));
+            case.times.extend(times);
         }
     }
     for case in &mut cases {
@@ -184,22 +231,25 @@ fn table(scene_name: &str, rounds: usize, steps_per_round: usize) {
     };
     let all = med("all");
     let none = med("none");
+    // The noise: the standard deviation of the all-on case's round medians.
     let noise = cases.iter().find(|c| c.name == "all").map_or(0.0, |c| {
-        let lo = c
-            .round_medians
+        let n = c.round_medians.len().max(1) as f64;
+        let mean = c.round_medians.iter().sum::<f64>() / n;
+        (c.round_medians
             .iter()
-            .copied()
-            .fold(f64::INFINITY, f64::min);
-        let hi = c.round_medians.iter().copied().fold(0.0, f64::max);
-        hi - lo
+            .map(|m| (m - mean).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt()
     });
     println!(
-        "\n{scene_name} ({} solver, {} strands, {} nodes): median µs per step over {rounds} rounds of {steps_per_round} steps",
+        "\n{scene_name} ({} solver, {} strands, {} nodes): median thread-CPU µs of one step from each of the same {} states, {rounds} rounds of {repeats} per state",
         base.params.solver.name(),
         base.strands.len(),
-        base.nodes()
+        base.nodes(),
+        states.len()
     );
-    println!("  all effects on: {all:.2} µs; nothing on: {none:.2} µs; noise (spread of the all-on round medians): {noise:.2} µs");
+    println!("  all effects on: {all:.2} µs; nothing on: {none:.2} µs; noise (standard deviation of the all-on round medians): {noise:.2} µs");
     println!(
         "  {:<16} {:>16} {:>16}",
         "effect", "all − without", "alone − none"
@@ -260,23 +310,19 @@ fn effects(c: &mut Criterion) {
     for scene_name in ["firmware", "firmware-dftl"] {
         let base = scene(scene_name);
         let mut group = c.benchmark_group(format!("effects/{scene_name}"));
-        for case in cases(&base) {
-            let Case {
-                name,
-                mut sim,
-                prepared,
-                mut k,
-                ..
-            } = case;
-            group.bench_function(name, |b| {
-                b.iter_batched_ref(
-                    || {
-                        k += 1;
-                        scene_inputs::<Libm>(&prepared, k - 1)
-                    },
-                    |inputs| sim.step(inputs),
-                    criterion::BatchSize::SmallInput,
-                )
+        let states = snapshots(&base);
+        for mut case in cases(&base) {
+            group.bench_function(case.name.clone(), |b| {
+                b.iter_custom(|iters| {
+                    let mut total = std::time::Duration::ZERO;
+                    for i in 0..iters {
+                        let inputs = case.restore(&states[i as usize % states.len()]);
+                        let start = Instant::now();
+                        black_box(case.sim.step(black_box(&inputs)));
+                        total += start.elapsed();
+                    }
+                    total
+                })
             });
         }
         group.finish();
@@ -293,9 +339,9 @@ criterion_group! {
 
 fn main() {
     // The table first: interleaved rounds under `cargo bench`, a few steps under `cargo test`.
-    let (rounds, steps) = if benching() { (20, 200) } else { (1, 3) };
+    let (rounds, repeats) = if benching() { (20, 10) } else { (1, 1) };
     for scene_name in ["firmware", "firmware-dftl"] {
-        table(scene_name, rounds, steps);
+        table(scene_name, rounds, repeats);
     }
     benches();
     Criterion::default().configure_from_args().final_summary();

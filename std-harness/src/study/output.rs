@@ -138,6 +138,17 @@ pub fn markdown(study: &Study) -> String {
     s
 }
 
+/// A cost axis tick: no more digits than the value needs.
+fn tick(v: f64) -> String {
+    if v >= 10.0 {
+        format!("{v:.0}")
+    } else if v >= 1.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
 const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
@@ -188,7 +199,7 @@ pub fn plot(study: &Study, path: &Path) -> Result<()> {
         .configure_mesh()
         .x_desc("µs per simulated ms (one thread; = µs per step at dt 1 ms)")
         .y_desc("RMS node distance from reference (m)")
-        .x_label_formatter(&|v| format!("{v:.3}"))
+        .x_label_formatter(&|v| tick(*v))
         .y_label_formatter(&|v| format!("{v:.0e}"))
         .draw()
         .map_err(|x| e(&x))?;
