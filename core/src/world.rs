@@ -57,7 +57,11 @@ pub fn step_strands<M: Math, const N: usize>(
             Solver::Dftl => crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report),
         }
         // 3. Guard: nothing non-finite leaves the step.
-        crate::guard::check(strand, &last_good, index, report);
+        // DFTL keeps every segment at length by construction; the rod's projection can be
+        // outrun by a configuration past its stability limit, so only the rod checks reach.
+        let inextensible = matches!(ctx.params.solver, Solver::Rod)
+            && ctx.has(crate::effects::Effect::Inextensibility);
+        crate::guard::check(strand, &last_good, inextensible, index, report);
     }
 }
 
