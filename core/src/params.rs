@@ -223,6 +223,29 @@ impl Params {
         },
     };
 
+    /// Checks that `strand` can be stepped stably with these parameters: with the rod solver and
+    /// bending on, the fixed substep count that keeps explicit bending within its stability
+    /// bound ([`crate::rod::step::needed_substeps`]) must fit [`crate::rod::step::MAX_SUBSTEPS`].
+    /// Stiffer hair, shorter segments or a larger `µ` lower the limit like
+    /// `h² / √(max(1, µ)·α)`; such a strand with too large a `dt` is refused here rather than
+    /// left to chatter or explode.
+    pub fn validate_strand<const N: usize>(
+        &self,
+        strand: &crate::strand::Strand<N>,
+    ) -> Result<(), ParamError> {
+        let bending = self.solver == Solver::Rod && self.effects.contains(Effect::Bending);
+        match crate::rod::step::needed_substeps(&strand.rest.rod, self.dt, bending) {
+            Some(_) => Ok(()),
+            None => Err(ParamError::OutOfRange {
+                field: "dt",
+                allowed: "at most 128 substeps' worth of the strand's explicit bending limit: \
+                          dt <= 128 * 0.7 * dt_max / 4 with dt_max = (h^2/2) * sqrt(rho*A / \
+                          (max(1, mu) * E*pi*r^4/4)) for the shortest segment h; use a smaller \
+                          dt, longer segments or softer hair",
+            }),
+        }
+    }
+
     /// Checks every parameter against its range and the effects against the solver.
     pub fn validate(&self) -> Result<(), ParamError> {
         let range = |ok: bool, field, allowed| {
