@@ -23,7 +23,7 @@
 //! projection and the guard keep it finite).
 //!
 //! With [`PROJECTED_SUBSTEPS_FROM`] or more substeps the segment lengths are also projected
-//! between substeps ([`inextensibility_between_substeps`]): a curved strand's bending forces
+//! between substeps (`inextensibility_between_substeps`): a curved strand's bending forces
 //! have components along its segments, and left unconstrained for a whole step they pumped
 //! energy into ×10 stiff hair on a shaking head and blew up 2 mm curls within 30 steps.
 //!
@@ -324,7 +324,7 @@ fn forces_and_integrate<M: Math, const N: usize>(
 }
 
 /// Fewest substeps at which the segment lengths are also projected between substeps
-/// ([`inextensibility_between_substeps`]). Human hair at 1 cm and 1 ms takes 4 and is left
+/// (`inextensibility_between_substeps`). Human hair at 1 cm and 1 ms takes 4 and is left
 /// as it was: with projections between its substeps the firmware scene's mean chatter rose from
 /// 1.2–1.45 to 1.6–1.7 rad and, with the hair-optimised twist, 2 of 13 shake frequencies
 /// reached 7–9.5 rad (`tests/stability.rs`) — its grab and contacts are only enforced at the
