@@ -25,13 +25,14 @@ const MAX_STRETCH: f32 = 1.0e-3;
 /// when healthy; a blow-up passes 1e-3 J within a few steps.
 const MAX_KINETIC_ENERGY: f64 = 1.0e-4;
 /// Mean over steps of the largest turning-angle second difference of each strand, rad. The
-/// scene measures 1.06–1.45 (strand 1, folded at the root by the shake, is the worst; the
-/// other strands 0.3–0.8); a saw-tooth instability of the stiffest mode sits at ≈ 3 and more.
-const MAX_MEAN_CHATTER: f64 = 1.6;
+/// scene measures 0.93–1.29 with either twist (fixed substeps; 1.06–1.45 with the earlier
+/// state-dependent count; strand 1, folded at the root by the shake, is the worst); a
+/// saw-tooth instability of the stiffest mode sits at ≈ 3 and more.
+const MAX_MEAN_CHATTER: f64 = 1.45;
 /// Largest turning-angle second difference in any single step, rad: the scene measures up to
-/// 6.0 in single steps (sharp root bends of a 30 cm hair with 1–6 cm segments); a blow-up
-/// reaches 9–12 within steps.
-const MAX_STEP_CHATTER: f32 = 7.0;
+/// 4.3 in single steps (sharp root bends of a hair with 1 cm segments; 6.0 with the earlier
+/// substep count); a blow-up reaches 9–12 within steps.
+const MAX_STEP_CHATTER: f32 = 5.5;
 
 /// Turning vector `φ_i b̂_i` at interior node `i`: the turning angle along the unit binormal,
 /// so that a zig-zag's alternating turns have alternating signs.
