@@ -1,38 +1,49 @@
 //! One rod step, Kmoch 2009 Algorithm 1, as a list of stages each gated by the scene's effects.
 //!
-//! # Stiff hair: a fixed number of substeps
+//! # Stiff hair: a fixed number of substeps, decided by the scene
 //!
 //! Symplectic Euler on the bending forces is stable for `dt ≤ dt_max = (h²/2)·√(ρA/(max(1,µ)α))`
 //! (DESIGN.md "Stability"; [`RodRest::stable_time_step`](super::energy::RodRest)). Human hair
 //! at 1 cm segments sits at 60–90 % of it at 1 ms, so stiffer hair (or µ > 1) would chatter. The
-//! remedy chosen here is substepping: stages (1) and (2) run
-//! `k = ⌈dt · (2/g) / (SAFETY · dt_max)⌉` times with `dt / k` ([`substeps_for_shape`]), where
-//! `g = min_i d_i / (|ê^{i−1}||ê^i|)` is the smallest relative binormal denominator of the
-//! shape the step starts from (2 when straight). The bending stiffness of the discrete rod is
-//! not the rest stiffness: `(κb)_i = 2 tan(φ_i/2)` makes the Hessian grow like `1/d_i²`, so a
-//! strand bent hard (a shaking head folds strands at the root to `φ ≈ 2 rad`, `g ≈ 0.5`) has a
-//! 4× shorter limit. A count from rest data alone ([`substeps`], the count at `g = 2`) let the
-//! firmware scene's stiffest mode run at 3× its limit after 600 steps and blow up. The count
-//! therefore depends on the state, bounded by [`MAX_SUBSTEPS`]: in fixed-cost mode a step's
-//! worst-case cost is `MAX_SUBSTEPS` force evaluations, reached only near a fold; a healthy
-//! human-hair scene stays at 1–4. `θ` is held over the substeps (the twist is quasistatic and
-//! solved once per step); the projection and the twist run once per step.
+//! remedy chosen here is a **fixed** number of substeps per strand: stages (1) and (2) run
+//! `k = ⌈dt · FOLD_ALLOWANCE / (SAFETY · dt_max)⌉` times with `dt / k` ([`substeps`]). `k`
+//! depends only on rest data and `dt`, so it is decided when the scene is set up and a step's
+//! cost does not depend on the state (fixed-cost mode: the same work on a calm and a violent
+//! step). A configuration that needs more than [`MAX_SUBSTEPS`] is refused by
+//! [`Params::validate_strand`](crate::params::Params::validate_strand).
 //!
-//! Cost: `k` evaluations of the frames and forces (O(n) each; one square root per segment and
-//! no trigonometry — the material angles' sines and cosines are computed once per step and
-//! shared by the substeps) plus `k` integrations. Measured on x86-64 (callgrind) for a 30-node
-//! strand: frames ≈ 6.0k instructions, forces ≈ 12.2k, so ≈ 18k per substep. At 1 cm and
-//! 1 ms, `k = 1, 3, 10, 30` for ×1, ×10, ×100, ×1000 human bending stiffness (µ = 1; `√µ` more
-//! for µ > 1), see the tests. A linearly implicit bending step (banded, half-bandwidth 8
-//! scalars) would cost about 3–4 explicit evaluations at any stiffness, so it wins beyond
-//! ≈ ×10–×20; substeps were chosen because they keep the very forces the finite-difference
-//! tests check (no linearisation, no linear solve, no extra damping), stay deterministic and
-//! bounded, and cost nothing extra for real hair (`k = 1`).
+//! Why [`FOLD_ALLOWANCE`]: the bending stiffness of the discrete rod is not the rest stiffness.
+//! `(κb)_i = 2 tan(φ_i/2)` makes the Hessian grow like `1/d_i²`, so the explicit limit of a
+//! strand bent to a turning angle `φ` is `dt_max · (1 + cos φ)/2` ([`substeps_for_shape`]). A
+//! shaking head bends strands at the root to `φ ≈ 2 rad` (`1 + cos φ ≈ 0.5`, measured on the
+//! firmware scene); a count from the straight limit alone let its stiffest mode run at 3× the
+//! limit and blow up. The allowance 4 covers turning angles up to 120°. In *converge* mode a
+//! strand bent further takes more substeps (up to [`MAX_SUBSTEPS`]); in *fixed-cost* mode it
+//! does not (a sharper fold than 120° between two 1 cm segments is not hair-like; the
+//! projection and the guard keep it finite).
+//!
+//! With [`PROJECTED_SUBSTEPS_FROM`] or more substeps the segment lengths are also projected
+//! between substeps (`inextensibility_between_substeps`): a curved strand's bending forces
+//! have components along its segments, and left unconstrained for a whole step they pumped
+//! energy into ×10 stiff hair on a shaking head and blew up 2 mm curls within 30 steps.
+//!
+//! Cost, measured on x86-64 (callgrind) for a 30-node strand: frames ≈ 6.0k instructions,
+//! forces ≈ 12.2k, so ≈ 18k per substep; one square root per segment and no trigonometry per
+//! substep (the material angles' sines and cosines are computed once per step). At 1 cm and
+//! 1 ms, µ = 1, `k = 4, 12, 38, 119` for ×1, ×10, ×100, ×1000 human bending stiffness
+//! (`√µ` more for µ > 1), see the tests. Wall time of a whole step of one 30-node strand on a
+//! shaking head, fixed-cost mode, projection cap 8 (test profile, opt-level 2, on this 2-core
+//! machine at load average 12, so an upper figure): 91 µs (×1), 219 µs (×10), 518 µs (×100),
+//! 1089 µs (×1000). A linearly implicit bending step (banded, half-bandwidth 8 scalars)
+//! would cost about 3–4 explicit evaluations at any stiffness and so wins beyond ≈ ×1;
+//! substeps were kept because they integrate the very forces the finite-difference tests
+//! check (no linearisation, no linear solve, no artificial damping) and stay deterministic and
+//! bounded.
 
 use super::energy::{
     elastic_forces_with_angles, material_angles, rest_root_frame, RodFrames, RodRest,
 };
-use super::twist::{hair_optimised_twist, newton_twist, ClampedFrames, TwistMethod};
+use super::twist::{hair_optimised_twist_with_angles, newton_twist, ClampedFrames, TwistMethod};
 use super::{ClampedSegments, ElasticTerms};
 use crate::context::StepContext;
 use crate::effects::Effect;
@@ -49,8 +60,11 @@ use crate::strand::Strand;
 /// uniform segments) keeps a margin for curved and uneven ones.
 pub const SAFETY: Real = 0.7;
 /// Most substeps a strand takes per step (bounded latency): enough for 1000× human bending
-/// stiffness at 1 cm segments and 1 ms.
-pub const MAX_SUBSTEPS: u32 = 64;
+/// stiffness at 1 cm segments and 1 ms (119, see the module documentation).
+pub const MAX_SUBSTEPS: u32 = 128;
+/// How much stiffer than straight the fixed substep count allows the strand to get by bending:
+/// `2/(1 + cos φ)` at the sharpest turning angle `φ`; 4 is `φ = 120°`.
+pub const FOLD_ALLOWANCE: Real = 4.0;
 
 /// Steps one strand by `ctx.dt`. `strand_index` is the strand's index in the whole scene (as
 /// in [`Grab::strand`]); `accelerations` (if any) are the caller's per-node accelerations for
@@ -72,14 +86,14 @@ pub fn step<M: Math, const N: usize>(
     let terms = elastic_terms(ctx);
     let start = StepStart::<M>::capture(strand, &clamped, terms);
     // (1) elastic forces [bending, twist] and (2) external forces + symplectic Euler, substepped.
-    forces_and_integrate::<M, N>(strand, ctx, &clamped, terms, accelerations, report);
+    let angles = forces_and_integrate::<M, N>(strand, ctx, &clamped, terms, accelerations, report);
     // (3) Root coupling: the head carries nodes 0 and 1, the root frame u^0 and θ^0.
     root_coupling_with_frame::<M, N>(strand, ctx, &start, report);
     // (4) Fast manifold projection [inextensibility, collisions, grabs] and velocity update.
     crate::projection::project_constraints::<M, N>(strand, ctx, grabs, strand_index, report);
     // (5) Twist [twist]: the Bishop frame in space for the new centreline, then θ.
     if ctx.has(Effect::Twist) {
-        update_twist::<M, N>(strand, ctx, &clamped, terms, &start, report);
+        update_twist::<M, N>(strand, ctx, &clamped, terms, &start, &angles, report);
     }
 }
 
@@ -137,12 +151,29 @@ fn strand_frames<M: Math, const N: usize>(strand: &Strand<N>) -> RodFrames<M, N>
     )
 }
 
-/// Substeps per step for this strand *at rest*: `⌈dt / (SAFETY · dt_max)⌉`, at least 1, at
-/// most [`MAX_SUBSTEPS`]. Depends only on rest data and `dt`. The step itself uses
-/// [`substeps_for_shape`], which also sees the current turning angles.
+/// The fixed substeps per step for this strand: `⌈dt · FOLD_ALLOWANCE / (SAFETY · dt_max)⌉`,
+/// at least 1, at most [`MAX_SUBSTEPS`]. Depends only on rest data and `dt` (decided at set-up;
+/// [`needed_substeps`] says whether the cap cuts it short).
 #[must_use]
 pub fn substeps<const N: usize>(rest: &RodRest<N>, dt: Real, bending: bool) -> u32 {
-    substeps_at_stiffness(rest, dt, bending, 1.0)
+    substeps_at_stiffness(rest, dt, bending, FOLD_ALLOWANCE)
+}
+
+/// The substeps [`substeps`] would take without the cap, or `None` when more than
+/// [`MAX_SUBSTEPS`] (or no finite count) are needed: the configuration cannot be made stable.
+#[must_use]
+pub fn needed_substeps<const N: usize>(rest: &RodRest<N>, dt: Real, bending: bool) -> Option<u32> {
+    if !bending || !rest.stable_time_step.is_finite() {
+        return Some(1);
+    }
+    let ratio = dt * FOLD_ALLOWANCE / (SAFETY * rest.stable_time_step);
+    if ratio <= 1.0 {
+        Some(1)
+    } else if ratio <= MAX_SUBSTEPS as Real {
+        Some(libm::ceilf(ratio) as u32)
+    } else {
+        None
+    }
 }
 
 /// Smallest `d_i / (|ê^{i−1}||ê^i|)` over the interior nodes of `frames`, with
@@ -214,9 +245,11 @@ fn substeps_at_stiffness<const N: usize>(
     }
 }
 
-/// Stages (1) and (2), `k` times with `h = dt/k` ([`substeps`]): the elastic forces of
+/// Stages (1) and (2), `k` times with `h = dt/k` ([`substeps`]; in converge mode more for a
+/// fold past [`FOLD_ALLOWANCE`], [`substeps_for_shape`]): the elastic forces of
 /// Kmoch Sec. 7.2 at the current `θ` ([`elastic_forces_with_angles`]), then
-/// [`external_forces_and_integrate`].
+/// [`external_forces_and_integrate`]. Returns `(cos θ^j, sin θ^j)` of the angles it used
+/// (the hair-optimised twist compares against them).
 fn forces_and_integrate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -224,17 +257,19 @@ fn forces_and_integrate<M: Math, const N: usize>(
     terms: ElasticTerms,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) {
+) -> [[Real; 2]; N] {
     let elastic = terms.bending || terms.twist;
     // The frames of the shape the step starts from: they set the substep count and serve the
     // first substep's forces.
     let mut frames = elastic.then(|| strand_frames::<M, N>(strand));
+    let fixed = substeps(&strand.rest.rod, ctx.dt, terms.bending);
     let k = match &frames {
-        Some(frames) if terms.bending => {
+        // Converge mode adapts to a fold sharper than the allowance; fixed cost never does.
+        Some(frames) if terms.bending && ctx.params.mode == Mode::Converge => {
             let smallest = smallest_binormal_denominator(frames, &strand.rest.rod.rest_length);
-            substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest)
+            fixed.max(substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest))
         }
-        _ => 1,
+        _ => fixed,
     };
     let h = ctx.dt / k as Real;
     let mut forces = [Vec3::ZERO; N];
@@ -248,7 +283,13 @@ fn forces_and_integrate<M: Math, const N: usize>(
     };
     report.ran(Stage::ExternalForces);
     report.ran(Stage::Integrate);
-    for _ in 0..k {
+    // Positions are the step's start plus a displacement summed over the substeps: adding
+    // `v·h` to a position of ~0.1 m rounds at ~4e-9 m, and k roundings per step would add up
+    // (a strand at rest drifted 2.4e-6 m in 10 s with k = 4 against 0.6e-6 m with k = 1).
+    let mut start = strand.state.position;
+    let mut displacement = [Vec3::ZERO; N];
+    let substep_projection = inextensibility_between_substeps(ctx, k, h);
+    for substep in 0..k {
         if elastic {
             let frames = frames
                 .take()
@@ -263,19 +304,79 @@ fn forces_and_integrate<M: Math, const N: usize>(
                 &mut forces,
             );
         }
-        external_forces_and_integrate(strand, ctx, &forces, h, accelerations);
+        external_forces_and_integrate(
+            strand,
+            ctx,
+            &forces,
+            h,
+            accelerations,
+            (&start, &mut displacement),
+        );
+        if let (Some(sub), true) = (&substep_projection, substep + 1 < k) {
+            // Segment lengths between substeps; the step's own projection follows the last.
+            let mut scratch = StepReport::default();
+            crate::projection::project_constraints::<M, N>(strand, sub, &[], 0, &mut scratch);
+            start = strand.state.position;
+            displacement = [Vec3::ZERO; N];
+        }
     }
+    cos_sin
+}
+
+/// Fewest substeps at which the segment lengths are also projected between substeps
+/// (`inextensibility_between_substeps`). Human hair at 1 cm and 1 ms takes 4 and is left
+/// as it was: with projections between its substeps the firmware scene's mean chatter rose from
+/// 1.2–1.45 to 1.6–1.7 rad and, with the hair-optimised twist, 2 of 13 shake frequencies
+/// reached 7–9.5 rad (`tests/stability.rs`) — its grab and contacts are only enforced at the
+/// end of the step. From 8 on (×10 stiffness at 1 cm: 12; curls in 2 mm segments: 94) they are
+/// what keeps the strand stable. An empirical threshold between measured cases, not a bound.
+pub const PROJECTED_SUBSTEPS_FROM: u32 = 8;
+/// Relative stretch (`|e·e − ê·ê| / ê·ê`) below which a projection between substeps does
+/// nothing; the step's own projection still meets the scene's tolerance.
+pub const SUBSTEP_PROJECTION_TOLERANCE: Real = 1.0e-4;
+
+/// The context of the inextensibility projection run between substeps (`None` below
+/// [`PROJECTED_SUBSTEPS_FROM`] substeps or without `inextensibility`): the substep's `h`,
+/// inextensibility only (contacts and grabs wait for the step's own projection, with the
+/// head's end-of-step pose).
+///
+/// Why: the substeps resolve bending's fast modes, but a curved strand's bending forces have
+/// components along its segments, and without the constraint those move freely for the whole
+/// step. A helix of radius 2 mm in 2 mm segments (94 substeps at 1 ms) stretched unchecked for
+/// 1 ms, the step's projection snapped it back (`v += Δx/dt`), and it blew up within 30 steps
+/// even on a still head; with the lengths kept at every substep it holds
+/// (`tests/torture.rs`). Cost: `k − 1` more tridiagonal projections per step.
+fn inextensibility_between_substeps(ctx: &StepContext, k: u32, h: Real) -> Option<StepContext> {
+    if k < PROJECTED_SUBSTEPS_FROM || !ctx.has(Effect::Inextensibility) {
+        return None;
+    }
+    let mut sub = ctx.clone();
+    sub.dt = h;
+    sub.inv_dt = 1.0 / h;
+    sub.effects = crate::effects::Effects::NONE.with(Effect::Inextensibility);
+    // Only a stretch worth undoing: a projection writes positions, and its velocity update
+    // `Δx/h` turns their rounding (~4e-9 m at 0.1 m) into ~1e-3 m/s of noise at the µs
+    // substeps of stiff or curly hair, so a strand at rest must not be projected at all.
+    // Converge mode with the tolerance raised to SUBSTEP_PROJECTION_TOLERANCE does that; the
+    // cost of these projections therefore depends on the state (at most `(k − 1)` × the cap).
+    sub.params.mode = Mode::Converge;
+    if sub.params.rod.projection_tolerance < SUBSTEP_PROJECTION_TOLERANCE {
+        sub.params.rod.projection_tolerance = SUBSTEP_PROJECTION_TOLERANCE;
+    }
+    Some(sub)
 }
 
 /// Symplectic Euler with the elastic forces `forces` and the external forces `F = M g − ν ẋ`
 /// plus caller accelerations: `v ← v + h F/m`, then `x ← x + h v` (Kmoch 2009 Sec. 7,
-/// Alg. 1 lines 7–8). Nodes 0 and 1 belong to the head.
+/// Alg. 1 lines 7–8), with `x = x_start + Σ v h` over the substeps so far. Nodes 0 and 1
+/// belong to the head.
 fn external_forces_and_integrate<const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     forces: &[Vec3; N],
     h: Real,
     accelerations: Option<&[Vec3]>,
+    (start, displacement): (&[Vec3; N], &mut [Vec3; N]),
 ) {
     let n = strand.rest.nodes.min(N);
     let drag = if ctx.has(Effect::Drag) {
@@ -287,18 +388,20 @@ fn external_forces_and_integrate<const N: usize>(
     let nodes = state
         .position
         .iter_mut()
+        .zip(start.iter().zip(displacement.iter_mut()))
         .zip(state.velocity.iter_mut())
         .zip(forces.iter().zip(&strand.rest.inverse_mass))
         .enumerate()
         .take(n)
         .skip(2);
-    for (i, ((x, v), (force, inverse_mass))) in nodes {
+    for (i, (((x, (x0, d)), v), (force, inverse_mass))) in nodes {
         let mut a = ctx.gravity + ctx.wind + (*force - *v * drag) * *inverse_mass;
         if let Some(extra) = accelerations.and_then(|acc| acc.get(i)) {
             a += *extra;
         }
         *v += a * h;
-        *x += *v * h;
+        *d += *v * h;
+        *x = *x0 + *d;
     }
 }
 
@@ -360,6 +463,7 @@ fn update_twist<M: Math, const N: usize>(
     clamped: &ClampedSegments,
     terms: ElasticTerms,
     start: &StepStart<M>,
+    angles: &[[Real; 2]; N],
     report: &mut StepReport,
 ) {
     report.ran(Stage::Twist);
@@ -371,7 +475,11 @@ fn update_twist<M: Math, const N: usize>(
         saved.transport(&frames, clamped, theta);
     }
     match ctx.params.rod.twist {
-        TwistMethod::HairOptimised => hair_optimised_twist(&frames, rest, clamped, terms, theta),
+        // The angles' cosines and sines from the start of the step: only clamped segments
+        // (skipped by the sweep) have moved since.
+        TwistMethod::HairOptimised => {
+            hair_optimised_twist_with_angles(&frames, rest, clamped, terms, theta, angles);
+        }
         TwistMethod::Newton => {
             let outcome = newton_twist(
                 &frames,

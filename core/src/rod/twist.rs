@@ -143,26 +143,53 @@ fn local_twist<const N: usize, R: Scalar>(
     energy
 }
 
-/// Kmoch 2009 Sec. 6.2, the hair-optimised twist, in place on `theta` (length ≥ segments).
-///
-/// Sweep root → tip (a fixed order: determinism) over the unclamped segments, with the
-/// already-updated `θ^{j−1}`: take the binormal direction ([`binormal_direction`]) as the
-/// representative mod π nearest `θ^{j−1} + m̂_j`, then keep whichever of `θ`, `θ + π`, `θ − π`
-/// has the least local energy, evaluated exactly (the paper's closed-form criteria assume
-/// uniform `l̂` and neighbours at rest twist). `ω(θ ± π) = −ω(θ)`. One candidate is added to
-/// the paper's three: the continuation at zero local twist `θ^{j−1} + m̂_j`, which is also the
-/// choice when both binormals vanish. Without it a nearly straight strand (binormals of
-/// rounding size, directions at random) takes random angles with up to π/2 of twist per
-/// segment and, with µ > 1, pumps energy into the bending modes until it diverges (seen at
-/// ×100 stiffness under a shaking head). Trigonometry: one `atan2` per segment (θ is stored as
-/// an angle); the cosines and sines are carried along the sweep. Angles stay continuous in time: every choice is made
-/// relative to the neighbour, and `θ^0` is unwrapped against its previous value.
+/// Kmoch 2009 Sec. 6.2, the hair-optimised twist, in place on `theta` (length ≥ segments):
+/// [`hair_optimised_twist_with_angles`] with the cosines and sines of `theta` computed here
+/// (one `sin_cos` per segment; the step passes the ones it already has).
 pub fn hair_optimised_twist<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     clamped: &ClampedSegments,
     terms: ElasticTerms,
     theta: &mut [P::R],
+) {
+    let segments = frames.nodes.saturating_sub(1).min(theta.len());
+    let current = material_angles::<P, N>(&theta[..segments]);
+    hair_optimised_twist_with_angles(frames, rest, clamped, terms, theta, &current);
+}
+
+/// Kmoch 2009 Sec. 6.2, the hair-optimised twist, in place on `theta`; `current[j]` holds
+/// `(cos θ^j, sin θ^j)` of the angles passed in.
+///
+/// Sweep root → tip (a fixed order: determinism) over the unclamped segments, with the
+/// already-updated `θ^{j−1}`: take the binormal direction ([`binormal_direction`]) as the
+/// representative mod π nearest `θ^{j−1} + m̂_j`, then keep whichever of the candidates has the
+/// least local energy, evaluated exactly (the paper's closed-form criteria assume uniform `l̂`
+/// and neighbours at rest twist; `ω(θ ± π) = −ω(θ)`). The candidates:
+/// * the paper's three, `θ`, `θ + π`, `θ − π`;
+/// * the continuation at zero local twist `θ^{j−1} + m̂_j`, also the choice when both binormals
+///   vanish: without it a nearly straight strand (binormals of rounding size, directions at
+///   random) takes random angles with up to π/2 of twist per segment;
+/// * **the current angle `θ^j`**, which wins ties. The local energies are exactly the terms of
+///   `E` that touch `θ^j` (bending at nodes `j`, `j+1` in frame `j`, twist at nodes `j`, `j+1`
+///   with the neighbours' angles as they are at that point of the sweep), so with the current
+///   angle among the candidates every update of the sweep lowers `E(x, θ)` or leaves it: the
+///   twist is a descent step, like Newton with its line search. Without it the sweep can move
+///   `θ^j` to a candidate of *higher* energy than the angle it had (all the paper's candidates
+///   may lie above it), so that each step's θ update adds elastic energy at fixed `x` — an
+///   energy pump: the firmware scene shaken at 13 frequencies blew up in 9 of them by step
+///   ~770 (`tests/stability.rs`).
+///
+/// Trigonometry: one `atan2` per segment (θ is stored as an angle); the cosines and sines are
+/// carried along the sweep. Angles stay continuous in time: every choice is made relative to
+/// the neighbour or the current angle, and `θ^0` is unwrapped against its previous value.
+pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    clamped: &ClampedSegments,
+    terms: ElasticTerms,
+    theta: &mut [P::R],
+    current: &[[P::R; 2]],
 ) {
     let segments = frames.nodes.saturating_sub(1).min(theta.len());
     if segments == 0 {
@@ -186,32 +213,34 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
             previous[0] * cm - previous[1] * sm,
             previous[1] * cm + previous[0] * sm,
         ];
-        let Some(direction) = binormal_direction(frames, j) else {
-            theta[j] = reference;
-            previous = reference_cos_sin;
-            continue;
-        };
-        let (angle, cos_sin) = nearest_representative::<P>(direction, reference);
-        let (aligned, flipped_bending) = local_bending(frames, rest, terms, j, cos_sin);
-        let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
-        let flipped = [-cos_sin[0], -cos_sin[1]];
         let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
-        let candidates = [
-            (angle, cos_sin, aligned),
-            (angle + P::R::PI, flipped, flipped_bending),
-            (angle - P::R::PI, flipped, flipped_bending),
-            // The continuation competes too: where the binormal barely bends the segment
-            // (nearly straight, µ ≈ 1) aligning with it would only add twist.
-            (reference, reference_cos_sin, continued),
-        ];
-        let mut best = (candidates[0].0, candidates[0].1);
-        let mut best_energy = candidates[0].2 + twist(candidates[0].0);
-        for &(candidate, candidate_cos_sin, bending) in &candidates[1..] {
+        // The current angle first: a candidate must be strictly lower to replace it.
+        let kept = theta[j];
+        let kept_cos_sin = match current.get(j) {
+            Some(&cs) => cs,
+            None => {
+                let (s, c) = P::sin_cos(kept);
+                [c, s]
+            }
+        };
+        let mut best = (kept, kept_cos_sin);
+        let mut best_energy = local_bending(frames, rest, terms, j, kept_cos_sin).0 + twist(kept);
+        let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
+        let mut consider = |candidate: P::R, cos_sin: [P::R; 2], bending: P::R| {
             let energy = bending + twist(candidate);
             if energy < best_energy {
-                best = (candidate, candidate_cos_sin);
+                best = (candidate, cos_sin);
                 best_energy = energy;
             }
+        };
+        consider(reference, reference_cos_sin, continued);
+        if let Some(direction) = binormal_direction(frames, j) {
+            let (angle, cos_sin) = nearest_representative::<P>(direction, reference);
+            let (aligned, flipped_bending) = local_bending(frames, rest, terms, j, cos_sin);
+            let flipped = [-cos_sin[0], -cos_sin[1]];
+            consider(angle, cos_sin, aligned);
+            consider(angle + P::R::PI, flipped, flipped_bending);
+            consider(angle - P::R::PI, flipped, flipped_bending);
         }
         theta[j] = best.0;
         previous = best.1;

@@ -419,6 +419,17 @@ pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
 
     // Last, so that the scene's own checks (which name their fields) speak first.
     params.validate().map_err(param_field)?;
+    // Each strand against the time step: stiff or finely divided rods past the explicit
+    // bending limit are refused here, not left to chatter.
+    for (i, s) in strands.iter().enumerate() {
+        if let Ok(strand) = Strand::<{ MAX_NODES as usize }>::from_polyline(&s.points, &s.material)
+        {
+            params.validate_strand(&strand).map_err(|e| {
+                let error = param_field(e);
+                FieldError::new("dt", format!("{} (strand {i}, {})", error.message, s.field))
+            })?;
+        }
+    }
 
     let motion = match scene.head.as_ref().and_then(|h| h.motion.as_ref()) {
         None | Some(MotionSpec::Still) => Motion::Still,
