@@ -83,6 +83,8 @@ fn every_builtin_runs_100_steps_and_stays_finite() {
             &loaded,
             &RunOptions {
                 steps: Some(100),
+                // Mannequin A is 349,000 vertices: all cores (the bits do not depend on it).
+                threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
                 ..RunOptions::default()
             },
         )
