@@ -183,14 +183,17 @@ fn scan(
         dx * dx + dy * dy + dz * dz
     };
     let blocks = x.len() / 8;
-    for b in 0..blocks {
-        let o = b * 8;
-        let (bx, by, bz) = (&x[o..o + 8], &y[o..o + 8], &z[o..o + 8]);
+    let chunks = x
+        .chunks_exact(8)
+        .zip(y.chunks_exact(8))
+        .zip(z.chunks_exact(8));
+    for (b, ((bx, by), bz)) in chunks.enumerate() {
         let mut mask = 0u32;
         for l in 0..8 {
             let (dx, dy, dz) = (xa - bx[l], ya - by[l], za - bz[l]);
             mask |= u32::from(dx * dx + dy * dy + dz * dz < h2) << l;
         }
+        let o = b * 8;
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
