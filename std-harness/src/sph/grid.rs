@@ -109,8 +109,8 @@ impl Grid {
     }
 
     /// The sorted ranges holding every particle of the 27 cells around `cell`: the span of
-    /// buckets of its own three cells along x first, then the others in ascending bucket
-    /// order, each bucket once (rows that collide give the same span twice: it is read once).
+    /// buckets of its own three cells along x first, then the others in a fixed order, each
+    /// bucket once (rows that collide give the same span twice: it is read once).
     /// Returns the ranges and how many there are.
     #[must_use]
     pub fn ranges_around(&self, cell: [i32; 3]) -> ([(u32, u32); 18], usize) {
@@ -131,29 +131,23 @@ impl Grid {
                 l => [(row(x) + l - 1, row(x) + l + 1), (u32::MAX, u32::MAX)],
             }
         };
-        let mut all = [(u32::MAX, u32::MAX); 18];
-        let mut n = 0;
-        for dy in -1..=1 {
-            for dz in -1..=1 {
-                for span in spans(y + dy, z + dz) {
-                    if span.0 != u32::MAX {
-                        all[n] = span;
-                        n += 1;
-                    }
-                }
-            }
-        }
-        // Own span first (the nearest cells, kept first when the cap truncates).
+        // Own span first (the nearest cells, kept first when the cap truncates), then the
+        // others in the fixed (dy, dz) order, a span that collides with one already taken
+        // skipped (a linear search over at most 17: cheaper than sorting).
         let own = spans(y, z)[0];
+        let mut taken = [own; 18];
         let mut out = [(0, 0); 18];
         out[0] = self.range(own);
         let mut m = 1;
-        let rest = &mut all[..n];
-        rest.sort_unstable();
-        for (i, &span) in rest.iter().enumerate() {
-            if span != own && (i == 0 || span != rest[i - 1]) {
-                out[m] = self.range(span);
-                m += 1;
+        for dy in -1..=1 {
+            for dz in -1..=1 {
+                for span in spans(y + dy, z + dz) {
+                    if span.0 != u32::MAX && !taken[..m].contains(&span) {
+                        taken[m] = span;
+                        out[m] = self.range(span);
+                        m += 1;
+                    }
+                }
             }
         }
         (out, m)
