@@ -8,8 +8,9 @@
 //! lists reach their working size), then times `STEPS` steps by the wall clock and by the
 //! process's CPU time (`/proc/self/stat`; on a shared machine the CPU figure is the steadier).
 //!
-//! `cargo bench -p hairsim-benches --bench sph` (all sizes), or with a filter on the scene
-//! name: `cargo bench -p hairsim-benches --bench sph -- mannequin-a`. Under
+//! `cargo bench -p hairsim-benches --bench sph` (everything), or picking scenes, columns and
+//! thread counts by name: `cargo bench -p hairsim-benches --bench sph -- mannequin-a
+//! dftl+shape+hair-hair 2t`. Under
 //! `cargo test --benches` each configuration of the two smallest sizes runs two steps.
 
 use std::time::{Duration, Instant};
@@ -75,6 +76,9 @@ const SIZES: &[Size] = &[
         nodes: 12,
     },
 ];
+
+/// Table 1's columns.
+const COLUMNS: &[&str] = &["dftl", "dftl+shape", "dftl+shape+hair-hair"];
 
 /// The mannequin scene (DFTL + shape + hair–hair) with `size`'s strands and nodes, and the
 /// effects of `column`.
@@ -155,11 +159,24 @@ fn main() {
         if quick && size.strands * size.nodes > 10_000 {
             continue;
         }
-        if !filter.is_empty() && !filter.iter().any(|f| size.name.contains(f.as_str())) {
+        let picked = |name: &str, all: &[&str]| {
+            let named: Vec<&&String> = filter
+                .iter()
+                .filter(|f| all.contains(&f.as_str()))
+                .collect();
+            named.is_empty() || named.iter().any(|f| f.as_str() == name)
+        };
+        if !picked(size.name, &SIZES.iter().map(|s| s.name).collect::<Vec<_>>()) {
             continue;
         }
-        for column in ["dftl", "dftl+shape", "dftl+shape+hair-hair"] {
+        for column in COLUMNS {
+            if !picked(column, COLUMNS) {
+                continue;
+            }
             for threads in [1, 2] {
+                if !picked(&format!("{threads}t"), &["1t", "2t"]) {
+                    continue;
+                }
                 match size.nodes {
                     0..=16 => run::<16>(size, column, threads, warm_up, steps),
                     _ => run::<32>(size, column, threads, warm_up, steps),

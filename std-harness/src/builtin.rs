@@ -367,7 +367,7 @@ fn mannequin(name: &str, leaders: u32, nodes: u32) -> Scene {
     // 6 mm reaches a few neighbouring strands (about 10 neighbours a node on the head); the
     // repulsion and viscosity within the paper's ranges ([0, 0.5], [0, 200]).
     scene.hair_hair = Some(crate::scene::HairHairSpec {
-        smoothing_length: Some(0.006),
+        smoothing_length: Some(0.0045),
         rest_density: Some(2.0),
         stiffness: Some(0.2),
         viscosity: Some(20.0),

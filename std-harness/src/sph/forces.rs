@@ -23,14 +23,14 @@ use std::f32::consts::PI;
 use hairsim_core::Vec3;
 use rayon::prelude::*;
 
-use super::neighbours::NeighbourLists;
+use super::neighbours::{NeighbourLists, PADDING};
 use super::{SphParams, CHUNK};
 
 /// Particles rearranged into the grid's sorted order (structure of arrays), and what is
 /// computed for them.
 #[derive(Clone, Debug, Default)]
 pub struct SortedParticles {
-    /// Positions, m: x.
+    /// Positions, m: x (and [`PADDING`] entries past the last particle, never a neighbour).
     pub x: Vec<f32>,
     /// Positions, m: y.
     pub y: Vec<f32>,
@@ -61,9 +61,9 @@ impl SortedParticles {
     #[must_use]
     pub fn new(n: usize) -> SortedParticles {
         SortedParticles {
-            x: vec![0.0; n],
-            y: vec![0.0; n],
-            z: vec![0.0; n],
+            x: vec![0.0; n + PADDING],
+            y: vec![0.0; n + PADDING],
+            z: vec![0.0; n + PADDING],
             velocity: vec![Vec3::ZERO; n],
             mass: vec![0.0; n],
             strand: vec![0; n],

@@ -2,12 +2,13 @@
 //! lines 2–4). Cells are cubes of the smoothing length `h`, so every neighbour of a particle
 //! lies in its own cell or one of the 26 around it.
 //!
-//! Cells map to a power-of-two number of buckets laid out in *rows*: the row of a cell is a
-//! hash of its `(y, z)` coordinates, and within a row 16 consecutive buckets take `x mod 16`.
-//! Three cells side by side along x are then (but at the wrap of 16) three consecutive
-//! buckets, which after the sort are one contiguous run of particles: the 27 cells around a
-//! particle are at most 9 rows, read as at most 18 contiguous ranges of the sorted arrays.
-//! Distinct cells may share a bucket; the neighbour search filters by distance.
+//! Cells map to a power-of-two number of buckets laid out in *rows*: a row is 16 cells side by
+//! side along x, rows are grouped in bricks of 4 × 4 ([`row_of`]) placed by a hash, and within
+//! a row 16 consecutive buckets take `x mod 16`. Three cells side by side along x are then (but
+//! where they cross from one row to the next) three consecutive buckets, which after the sort
+//! are one contiguous run of particles: the 27 cells around a particle are read as at most 18
+//! contiguous ranges of the sorted arrays, 9 in most places. Distinct cells may share a bucket
+//! (rows collide); the neighbour search filters by distance.
 
 use hairsim_core::Vec3;
 
@@ -23,18 +24,24 @@ pub fn cell_of(p: Vec3, inverse_cell: f32) -> [i32; 3] {
     [c(p.x), c(p.y), c(p.z)]
 }
 
-/// The row of cells `(·, y, z)`: the spatial hash of Teschner et al. 2003 on two coordinates.
+/// The row holding cell `(x, y, z)`. Rows come in *bricks* of 4 × 4 rows (16 × 4 × 4 cells),
+/// placed by the spatial hash of Teschner et al. 2003 on `(x div 16, y div 4, z div 4)`; within
+/// a brick, `(y mod 4, z mod 4)` picks the row. The 9 rows around a cell then mostly lie in one
+/// or two bricks: a few kilobytes of the sorted arrays rather than nine random places.
 #[inline]
 #[must_use]
-pub fn row_of(y: i32, z: i32, row_mask: u32) -> u32 {
-    ((y as u32).wrapping_mul(19_349_663) ^ (z as u32).wrapping_mul(83_492_791)) & row_mask
+pub fn row_of(x: i32, y: i32, z: i32, row_mask: u32) -> u32 {
+    let brick = ((x >> 4) as u32).wrapping_mul(73_856_093)
+        ^ ((y >> 2) as u32).wrapping_mul(19_349_663)
+        ^ ((z >> 2) as u32).wrapping_mul(83_492_791);
+    ((brick << 4) | ((y as u32 & 3) << 2) | (z as u32 & 3)) & row_mask
 }
 
 /// The bucket of a cell.
 #[inline]
 #[must_use]
 pub fn bucket_of(cell: [i32; 3], row_mask: u32) -> u32 {
-    row_of(cell[1], cell[2], row_mask) * ROW + (cell[0] as u32 & (ROW - 1))
+    row_of(cell[0], cell[1], cell[2], row_mask) * ROW + (cell[0] as u32 & (ROW - 1))
 }
 
 /// The grid: the counting sort's output and its scratch.
@@ -101,54 +108,58 @@ impl Grid {
         }
     }
 
-    /// The sorted ranges holding every particle of the 27 cells around `cell`: its own row
-    /// first, then the other rows in ascending order, each row once; within a row ascending
-    /// buckets. Returns the ranges and how many there are.
+    /// The sorted ranges holding every particle of the 27 cells around `cell`: the span of
+    /// buckets of its own three cells along x first, then the others in a fixed order, each
+    /// bucket once (rows that collide give the same span twice: it is read once).
+    /// Returns the ranges and how many there are.
     #[must_use]
     pub fn ranges_around(&self, cell: [i32; 3]) -> ([(u32, u32); 18], usize) {
-        let own = row_of(cell[1], cell[2], self.row_mask);
-        let mut rows = [own; 9];
-        let mut n = 1;
+        let [x, y, z] = cell;
+        let low = x as u32 & (ROW - 1);
+        // Bucket spans (first, last) of cells x − 1 ..= x + 1 in the row of (y, z).
+        let spans = |y: i32, z: i32| -> [(u32, u32); 2] {
+            let row = |x: i32| row_of(x, y, z, self.row_mask) * ROW;
+            match low {
+                0 => [
+                    (row(x), row(x) + 1),
+                    (row(x - 1) + ROW - 1, row(x - 1) + ROW - 1),
+                ],
+                l if l == ROW - 1 => [
+                    (row(x) + ROW - 2, row(x) + ROW - 1),
+                    (row(x + 1), row(x + 1)),
+                ],
+                l => [(row(x) + l - 1, row(x) + l + 1), (u32::MAX, u32::MAX)],
+            }
+        };
+        // Own span first (the nearest cells, kept first when the cap truncates), then the
+        // others in the fixed (dy, dz) order, a span that collides with one already taken
+        // skipped (a linear search over at most 17: cheaper than sorting).
+        let own = spans(y, z)[0];
+        let mut taken = [own; 18];
+        let mut out = [(0, 0); 18];
+        out[0] = self.range(own);
+        let mut m = 1;
         for dy in -1..=1 {
             for dz in -1..=1 {
-                let r = row_of(cell[1] + dy, cell[2] + dz, self.row_mask);
-                if !rows[..n].contains(&r) {
-                    rows[n] = r;
-                    n += 1;
-                }
-            }
-        }
-        rows[1..n].sort_unstable();
-        let x = cell[0] as u32 & (ROW - 1);
-        let mut out = [(0, 0); 18];
-        let mut m = 0;
-        for &r in &rows[..n] {
-            let base = (r * ROW) as usize;
-            let span = |lo: u32, hi: u32| {
-                (
-                    self.bucket_start[base + lo as usize],
-                    self.bucket_start[base + hi as usize + 1],
-                )
-            };
-            // x − 1, x, x + 1 within the row of 16, wrapping.
-            match x {
-                0 => {
-                    out[m] = span(0, 1);
-                    out[m + 1] = span(ROW - 1, ROW - 1);
-                    m += 2;
-                }
-                x if x == ROW - 1 => {
-                    out[m] = span(0, 0);
-                    out[m + 1] = span(ROW - 2, ROW - 1);
-                    m += 2;
-                }
-                x => {
-                    out[m] = span(x - 1, x + 1);
-                    m += 1;
+                for span in spans(y + dy, z + dz) {
+                    if span.0 != u32::MAX && !taken[..m].contains(&span) {
+                        taken[m] = span;
+                        out[m] = self.range(span);
+                        m += 1;
+                    }
                 }
             }
         }
         (out, m)
+    }
+
+    /// The sorted range of buckets `first ..= last`.
+    #[inline]
+    fn range(&self, (first, last): (u32, u32)) -> (u32, u32) {
+        (
+            self.bucket_start[first as usize],
+            self.bucket_start[last as usize + 1],
+        )
     }
 }
 

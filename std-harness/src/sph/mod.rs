@@ -280,10 +280,11 @@ impl Sph {
         let (position, velocity, cell) = (&self.position, &self.velocity, &self.cell);
         let (mass, strand, node) = (&self.mass, &self.strand, &self.node);
         let s = &mut self.sorted;
+        let n = order.len();
         (
-            s.x.par_chunks_mut(CHUNK),
-            s.y.par_chunks_mut(CHUNK),
-            s.z.par_chunks_mut(CHUNK),
+            s.x[..n].par_chunks_mut(CHUNK),
+            s.y[..n].par_chunks_mut(CHUNK),
+            s.z[..n].par_chunks_mut(CHUNK),
             s.velocity.par_chunks_mut(CHUNK),
             s.mass.par_chunks_mut(CHUNK),
             s.strand.par_chunks_mut(CHUNK),

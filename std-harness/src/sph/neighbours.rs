@@ -16,6 +16,9 @@ use super::forces::{poly6_factor, SortedParticles};
 use super::grid::Grid;
 use super::{SphParams, CHUNK};
 
+/// Lanes of the distance test, and entries past the last particle in the position arrays.
+pub const PADDING: usize = 8;
+
 /// One list of at most `cap` neighbours per particle, in sorted indices.
 #[derive(Clone, Debug)]
 pub struct NeighbourLists {
@@ -76,7 +79,7 @@ impl NeighbourLists {
     /// pressure (`p.density`, `p.pressure`) and its packed force inputs (`p.packed`).
     pub fn build(&mut self, grid: &Grid, p: &mut SortedParticles, params: &SphParams) -> Found {
         let cap = self.cap;
-        let n = p.x.len();
+        let n = p.mass.len();
         let h = params.smoothing_length;
         let h2 = h * h;
         let c6 = poly6_factor(h);
@@ -166,7 +169,9 @@ impl NeighbourLists {
 }
 
 /// Calls `hit(j, r²)` for every sorted particle `j` in `s .. e` with `r² < h2`, in order. The
-/// distance test runs on blocks of eight (vectorised), the calls only for the hits.
+/// distance test runs on blocks of eight (vectorised), the calls only for the hits. Ranges
+/// are short (a few cells' particles), so the last block is not done one by one but masked:
+/// the position arrays carry [`PADDING`] entries past the last particle for it to read.
 #[inline(always)]
 fn scan(
     s: usize,
@@ -176,31 +181,33 @@ fn scan(
     (x, y, z): (&[f32], &[f32], &[f32]),
     mut hit: impl FnMut(usize, f32),
 ) {
-    let (x, y, z) = (&x[s..e], &y[s..e], &z[s..e]);
     let [xa, ya, za] = me.x;
-    let d2 = |i: usize| {
-        let (dx, dy, dz) = (xa - x[i], ya - y[i], za - z[i]);
-        dx * dx + dy * dy + dz * dz
-    };
-    let blocks = x.len() / 8;
-    for b in 0..blocks {
-        let o = b * 8;
-        let (bx, by, bz) = (&x[o..o + 8], &y[o..o + 8], &z[o..o + 8]);
+    let len = e - s;
+    let mut o = 0;
+    while o < len {
+        let at = s + o;
+        let (Some(bx), Some(by), Some(bz)) = (
+            x.get(at..at + PADDING),
+            y.get(at..at + PADDING),
+            z.get(at..at + PADDING),
+        ) else {
+            return;
+        };
+        let mut d2 = [0.0f32; PADDING];
         let mut mask = 0u32;
-        for l in 0..8 {
+        for l in 0..PADDING {
             let (dx, dy, dz) = (xa - bx[l], ya - by[l], za - bz[l]);
-            mask |= u32::from(dx * dx + dy * dy + dz * dz < h2) << l;
+            d2[l] = dx * dx + dy * dy + dz * dz;
+            mask |= u32::from(d2[l] < h2) << l;
+        }
+        if len - o < PADDING {
+            mask &= (1 << (len - o)) - 1;
         }
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            hit(s + o + l, d2(o + l));
+            hit(at + l, d2[l]);
         }
-    }
-    for i in blocks * 8..x.len() {
-        let r2 = d2(i);
-        if r2 < h2 {
-            hit(s + i, r2);
-        }
+        o += PADDING;
     }
 }
