@@ -328,13 +328,16 @@ struct NearColliders {
     /// Smallest and largest coordinates of the free nodes at the start.
     low: Vec3,
     high: Vec3,
+    /// Slack for f32's rounding of the per-node tests, m.
+    rounding: Real,
     /// Sum of the longest moves so far, m.
     grown: Real,
     /// Whether the strand has a free node (else nothing is tested).
     free: bool,
     /// Whether the box is usable: every position and move finite.
     bounded: bool,
-    /// Bit `k`: `shapes[k]` is near. The near shapes, in the step's order.
+    /// Bit `k`: `shapes[k]` is near (once all are, no more tests: the set only grows). The
+    /// near shapes, in the step's order.
     mask: u32,
     near: [(u8, Shape); MAX_COLLIDERS],
     count: usize,
@@ -367,13 +370,15 @@ impl NearColliders {
                 }
             }
         }
+        let rounding = 1.0e-5 * magnitude(low).max(magnitude(high)) + 1.0e-6;
         NearColliders {
             low,
             high,
+            rounding,
             grown: 0.0,
             free,
             bounded: crate::math::is_finite(sum),
-            mask: u32::MAX,
+            mask: 0,
             near: [(0, placeholder); MAX_COLLIDERS],
             count: 0,
         }
@@ -397,14 +402,21 @@ impl NearColliders {
             // Garbage positions: test every node as ever.
             return shapes;
         }
-        let scale = magnitude(self.low).max(magnitude(self.high));
-        let slack = self.grown * 1.001 + 1.0e-5 * scale + 1.0e-6;
+        let all = (1u32 << shapes.len().min(MAX_COLLIDERS)) - 1;
+        if self.mask == all {
+            return shapes;
+        }
+        let slack = self.grown * 1.001 + self.rounding;
         let (low, high) = (self.low - slack, self.high + slack);
         let mut mask = 0;
         for (k, (_, shape)) in shapes.iter().enumerate().take(MAX_COLLIDERS) {
             if may_touch_box(shape, low, high) {
                 mask |= 1 << k;
             }
+        }
+        if mask == all {
+            self.mask = all;
+            return shapes;
         }
         if mask != self.mask {
             self.mask = mask;
