@@ -348,86 +348,130 @@ pub fn evaluate<M: Math, const N: usize>(
     rows.converged = true;
     rows.max_depth = 0.0;
     rows.truncated = false;
+    let count = nodes.count.min(N);
+    // Without collision slots no node ever gets a contact (counts stay 0 from `Default`).
+    if layout.contact_slots > 0 {
+        detect_contacts::<M, N>(strand, nodes, colliders, layout, tolerance, memory, rows);
+    }
+    // Contacts first, then segments: the residual is a maximum, the convergence test a
+    // conjunction, so the order changes neither (a NaN segment value now always stays
+    // visible in the residual, where a later contact's `max` could hide it before).
+    lay_out_segments(strand, nodes, layout, tolerance, rows, count);
+    if layout.fixed_cost {
+        // The full band for every row: the factorisation's work is the same whatever holds.
+        for (r, first) in rows.first.iter_mut().enumerate().take(rows.count) {
+            *first = r.saturating_sub(1) as u16;
+        }
+    }
+}
+
+/// The collision rows of every free node at this iterate (see [`evaluate`]).
+fn detect_contacts<M: Math, const N: usize>(
+    strand: &Strand<N>,
+    nodes: &Nodes<N>,
+    colliders: &[(u8, Shape)],
+    layout: Layout,
+    tolerance: Real,
+    memory: &mut ContactMemory<N>,
+    rows: &mut Rows<N>,
+) {
     let x = &strand.state.position;
     let rest_length = &strand.rest.segment_length;
     let count = nodes.count.min(N);
-    let mut previous_segment: Option<usize> = None;
     for i in 0..count {
         rows.contacts[i].count = 0;
-        rows.segment_row[i] = NO_ROW;
-        if layout.contact_slots > 0 && nodes.is_free(i) {
-            for &(c, ref shape) in colliders {
-                let bit = 1u8 << (c % 8);
-                // Test the bit first: most nodes never touch anything.
-                let sticky = memory.touched[i] & bit != 0
-                    && memory.multipliers[i]
-                        .get(usize::from(c))
-                        .is_some_and(|&lambda| lambda < 0.0);
-                let found = if sticky {
-                    Some(surface::<M>(shape, x[i]))
-                } else {
-                    shape.penetration::<M>(x[i]).map(|c| (c.normal, c.depth))
-                };
-                let Some((normal, depth)) = found else {
-                    continue;
-                };
-                if depth > 0.0 {
-                    // Node i ≥ 2 when free, so the segment before it exists.
-                    let scale = rest_length[i.saturating_sub(1)];
-                    rows.residual = rows.residual.max(depth / scale);
-                    rows.max_depth = rows.max_depth.max(depth);
-                    if rows.converged && depth > tolerance * scale {
-                        let reach = match *shape {
-                            Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
-                            Shape::Plane { point, .. } => magnitude(point),
-                        };
-                        // Past 1 % of the segment f32 resolves nothing: not converged.
-                        let floor = resolution_floor(true, x[i], x[i], reach).min(0.01 * scale);
-                        rows.converged = depth <= floor;
-                    }
-                }
-                let (value, gradient) = contact(shape, normal, depth);
-                let room = usize::from(rows.contacts[i].count) < layout.contact_slots;
-                if room && rows.contacts[i].push(c, value, gradient) {
-                    memory.touched[i] |= bit;
-                } else {
-                    rows.truncated = true;
-                }
-            }
-        }
-        if i + 1 >= count || !layout.inextensibility {
+        if colliders.is_empty() || !nodes.is_free(i) {
             continue;
         }
-        if nodes.is_free(i) || nodes.is_free(i + 1) {
+        for &(c, ref shape) in colliders {
+            let bit = 1u8 << (c % 8);
+            // Test the bit first: most nodes never touch anything.
+            let sticky = memory.touched[i] & bit != 0
+                && memory.multipliers[i]
+                    .get(usize::from(c))
+                    .is_some_and(|&lambda| lambda < 0.0);
+            let found = if sticky {
+                Some(surface::<M>(shape, x[i]))
+            } else {
+                shape.penetration::<M>(x[i]).map(|c| (c.normal, c.depth))
+            };
+            let Some((normal, depth)) = found else {
+                continue;
+            };
+            if depth > 0.0 {
+                // Node i ≥ 2 when free, so the segment before it exists.
+                let scale = rest_length[i.saturating_sub(1)];
+                rows.residual = rows.residual.max(depth / scale);
+                rows.max_depth = rows.max_depth.max(depth);
+                if rows.converged && depth > tolerance * scale {
+                    let reach = match *shape {
+                        Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
+                        Shape::Plane { point, .. } => magnitude(point),
+                    };
+                    // Past 1 % of the segment f32 resolves nothing: not converged.
+                    let floor = resolution_floor(true, x[i], x[i], reach).min(0.01 * scale);
+                    rows.converged = depth <= floor;
+                }
+            }
+            let (value, gradient) = contact(shape, normal, depth);
+            let room = usize::from(rows.contacts[i].count) < layout.contact_slots;
+            if room && rows.contacts[i].push(c, value, gradient) {
+                memory.touched[i] |= bit;
+            } else {
+                rows.truncated = true;
+            }
+        }
+    }
+}
+
+/// The segment rows in band order (or only their residual, `layout.residual_only`), and
+/// `segment_row` for every node.
+fn lay_out_segments<const N: usize>(
+    strand: &Strand<N>,
+    nodes: &Nodes<N>,
+    layout: Layout,
+    tolerance: Real,
+    rows: &mut Rows<N>,
+    count: usize,
+) {
+    let x = &strand.state.position;
+    let rest_length = &strand.rest.segment_length;
+    for r in rows.segment_row.iter_mut().take(count) {
+        *r = NO_ROW;
+    }
+    if !layout.inextensibility {
+        return;
+    }
+    let mut previous_segment: Option<usize> = None;
+    let mut free_here = nodes.is_free(0);
+    for i in 0..count.saturating_sub(1) {
+        let free_next = nodes.is_free(i + 1);
+        if free_here || free_next {
+            let (a, b) = (x[i], x[i + 1]);
             let rest2 = rest_length[i] * rest_length[i];
             if layout.residual_only {
-                let e = x[i + 1] - x[i];
+                let e = b - a;
                 let value = e.dot(e) - rest2;
-                rows.meet(value, rest2, tolerance, x[i], x[i + 1]);
-                continue;
-            }
-            let row = Row::segment(i, x[i], x[i + 1], rest_length[i]);
-            rows.meet(row.value, rest2, tolerance, x[i], x[i + 1]);
-            let first = previous_segment.unwrap_or(rows.count);
-            previous_segment = rows.push(row, first);
-            if let Some(r) = previous_segment {
-                rows.segment_row[i] = r as u16;
+                rows.meet(value, rest2, tolerance, a, b);
+            } else {
+                let row = Row::segment(i, a, b, rest_length[i]);
+                rows.meet(row.value, rest2, tolerance, a, b);
+                let first = previous_segment.unwrap_or(rows.count);
+                previous_segment = rows.push(row, first);
+                if let Some(r) = previous_segment {
+                    rows.segment_row[i] = r as u16;
+                }
             }
         } else {
             // Both ends prescribed (segment 0, or a grab next to the root or to another grab):
             // nothing can move, so no row. Fixed cost keeps a padding row in its place
             // (segment 0 is always prescribed and needs none), so that the row count does
             // not depend on which grabs hold.
-            if layout.fixed_cost && i >= 1 {
+            if layout.fixed_cost && i >= 1 && !layout.residual_only {
                 rows.push(Row::default(), rows.count);
             }
             previous_segment = None;
         }
-    }
-    if layout.fixed_cost {
-        // The full band for every row: the factorisation's work is the same whatever holds.
-        for (r, first) in rows.first.iter_mut().enumerate().take(rows.count) {
-            *first = r.saturating_sub(1) as u16;
-        }
+        free_here = free_next;
     }
 }

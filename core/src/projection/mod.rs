@@ -275,6 +275,7 @@ fn iterate<M: Math, const N: usize>(
     let cap = u32::from(ctx.params.rod.projection_iterations);
     let tolerance = ctx.params.rod.projection_tolerance;
     let mut outcome = Outcome::default();
+    let mut near = NearColliders::new(strand, &work.nodes, shapes, layout.contact_slots > 0);
     for k in 0..=cap {
         // After the last solve only the residual is wanted: no rows.
         let layout = Layout {
@@ -284,7 +285,7 @@ fn iterate<M: Math, const N: usize>(
         constraints::evaluate::<M, N>(
             strand,
             &work.nodes,
-            shapes,
+            near.shapes(shapes),
             layout,
             tolerance,
             &mut work.contacts,
@@ -297,7 +298,10 @@ fn iterate<M: Math, const N: usize>(
             break;
         }
         match solve_and_move::<M, N>(strand, held, work) {
-            Some(dropped) => outcome.dropped_rows += dropped,
+            Some((dropped, moved)) => {
+                outcome.dropped_rows += dropped;
+                near.moved::<M>(moved);
+            }
             // A non-finite multiplier (overflow on absurd input): keep x_k, stop, report.
             None => {
                 outcome.dropped_rows += 1;
@@ -309,14 +313,175 @@ fn iterate<M: Math, const N: usize>(
     outcome
 }
 
+/// The colliders a strand may touch during its projection, so that the nodes of a strand far
+/// from a collider skip its per-node test (Table 3's goal: collisions nearly free where there
+/// is no contact).
+///
+/// The free nodes' bounding box is taken once, at the start of the projection; each iteration
+/// moves every node by at most its longest move (`solve_and_move`), so by iterate `k` all
+/// free nodes lie in the box grown by the sum of the longest moves so far. A collider that
+/// misses that grown box (with a relative slack far above f32's rounding) has no free node
+/// inside it: its per-node test would find nothing, so skipping it changes no bit. The grown
+/// boxes only grow, so the near set only grows: a node that got a collision row keeps its
+/// collider in the set (and so its sticky row, see [`constraints::evaluate`]).
+struct NearColliders {
+    /// Smallest and largest coordinates of the free nodes at the start.
+    low: Vec3,
+    high: Vec3,
+    /// Slack for f32's rounding of the per-node tests, m.
+    rounding: Real,
+    /// Sum of the longest moves so far, m.
+    grown: Real,
+    /// Whether the strand has a free node (else nothing is tested).
+    free: bool,
+    /// Whether the box is usable: every position and move finite.
+    bounded: bool,
+    /// Bit `k`: `shapes[k]` is near (once all are, no more tests: the set only grows). The
+    /// near shapes, in the step's order.
+    mask: u32,
+    near: [(u8, Shape); MAX_COLLIDERS],
+    count: usize,
+}
+
+impl NearColliders {
+    fn new<const N: usize>(
+        strand: &Strand<N>,
+        nodes: &constraints::Nodes<N>,
+        shapes: &[(u8, Shape)],
+        collisions: bool,
+    ) -> Self {
+        let placeholder = Shape::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        let mut low = Vec3::splat(Real::MAX);
+        let mut high = Vec3::splat(-Real::MAX);
+        // NaN and infinities propagate into the sum where min/max would hide them.
+        let mut sum = Vec3::ZERO;
+        let mut free = false;
+        if collisions && !shapes.is_empty() {
+            let positions = strand.state.position.iter().zip(nodes.inverse_mass.iter());
+            for (&x, &w) in positions.take(nodes.count.min(N)) {
+                if w > 0.0 {
+                    low = low.min(x);
+                    high = high.max(x);
+                    sum += x;
+                    free = true;
+                }
+            }
+        }
+        let rounding = 1.0e-5 * magnitude(low).max(magnitude(high)) + 1.0e-6;
+        NearColliders {
+            low,
+            high,
+            rounding,
+            grown: 0.0,
+            free,
+            bounded: crate::math::is_finite(sum),
+            mask: 0,
+            near: [(0, placeholder); MAX_COLLIDERS],
+            count: 0,
+        }
+    }
+
+    /// Adds an iteration's longest move (squared, before any trust-region scaling: an upper
+    /// bound of the move made).
+    fn moved<M: Math>(&mut self, longest2: Real) {
+        if self.bounded {
+            self.grown += M::sqrt(longest2);
+            self.bounded = self.grown.is_finite();
+        }
+    }
+
+    /// The colliders that may hold a free node at this iterate, in the step's order.
+    fn shapes<'a>(&'a mut self, shapes: &'a [(u8, Shape)]) -> &'a [(u8, Shape)] {
+        if !self.free {
+            return &[];
+        }
+        if !self.bounded {
+            // Garbage positions: test every node as ever.
+            return shapes;
+        }
+        let all = (1u32 << shapes.len().min(MAX_COLLIDERS)) - 1;
+        if self.mask == all {
+            return shapes;
+        }
+        let slack = self.grown * 1.001 + self.rounding;
+        let (low, high) = (self.low - slack, self.high + slack);
+        let mut mask = 0;
+        for (k, (_, shape)) in shapes.iter().enumerate().take(MAX_COLLIDERS) {
+            if may_touch_box(shape, low, high) {
+                mask |= 1 << k;
+            }
+        }
+        if mask == all {
+            self.mask = all;
+            return shapes;
+        }
+        if mask != self.mask {
+            self.mask = mask;
+            self.count = 0;
+            for (k, near) in shapes.iter().enumerate().take(MAX_COLLIDERS) {
+                if let (true, Some(slot)) = (mask & (1 << k) != 0, self.near.get_mut(self.count)) {
+                    *slot = *near;
+                    self.count += 1;
+                }
+            }
+        }
+        self.near.get(..self.count).unwrap_or(&[])
+    }
+}
+
+/// Largest absolute coordinate of `p`.
+fn magnitude(p: Vec3) -> Real {
+    p.x.abs().max(p.y.abs()).max(p.z.abs())
+}
+
+/// Whether some point of the box `low`–`high` may lie inside `shape` (never `false` when one
+/// does; `true` when unsure). The shape is grown by 1e-5 of its own coordinates, far above
+/// the rounding of the per-node tests (`Shape::penetration`) far from the origin.
+fn may_touch_box(shape: &Shape, low: Vec3, high: Vec3) -> bool {
+    match *shape {
+        Shape::Sphere { centre, radius } => {
+            let reach = radius + 1.0e-5 * (magnitude(centre) + radius);
+            let d = centre - centre.max(low).min(high);
+            let distance2 = d.dot(d);
+            // NaN (garbage positions) counts as near.
+            distance2 <= reach * reach || distance2.is_nan()
+        }
+        Shape::Capsule { a, b, radius } => {
+            let reach = radius + 1.0e-5 * (magnitude(a).max(magnitude(b)) + radius);
+            let (a_low, a_high) = (a.min(b) - reach, a.max(b) + reach);
+            !(a_low.x > high.x
+                || a_low.y > high.y
+                || a_low.z > high.z
+                || a_high.x < low.x
+                || a_high.y < low.y
+                || a_high.z < low.z)
+        }
+        Shape::Plane { point, normal } => {
+            // The box corner furthest behind the plane.
+            let pick = |n: Real, lo: Real, hi: Real| if n >= 0.0 { lo } else { hi };
+            let corner = Vec3::new(
+                pick(normal.x, low.x, high.x),
+                pick(normal.y, low.y, high.y),
+                pick(normal.z, low.z, high.z),
+            );
+            let height = (corner - point).dot(normal);
+            height <= 1.0e-5 * magnitude(point) || height.is_nan()
+        }
+    }
+}
+
 /// One projection step: `(∇C M⁻¹ ∇Cᵀ) δλ = C`, `x ← x − M⁻¹ ∇Cᵀ δλ`, and the forces' sums.
-/// Returns the rows dropped at a singular pivot, or `None` (and leaves `x` alone) when the
-/// multipliers are not finite.
+/// Returns the rows dropped at a singular pivot and the longest node move asked for (squared,
+/// before the trust region), or `None` (and leaves `x` alone) when the multipliers are not
+/// finite.
 fn solve_and_move<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     held: &GrabbedNodes,
     work: &mut Workspace<N>,
-) -> Option<u32> {
+) -> Option<(u32, Real)> {
     let n = work.nodes.count.min(N);
     let mut dropped = banded::eliminate_contacts(&mut work.rows, n);
     let rows = work.rows.rows();
@@ -423,7 +588,7 @@ fn solve_and_move<M: Math, const N: usize>(
             }
         }
     }
-    Some(dropped)
+    Some((dropped, longest2))
 }
 
 /// `Σ_s ∇_{x_i}C_s δλ_s` over the (at most two) segments through node `i`, with the gradients

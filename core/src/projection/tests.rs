@@ -400,3 +400,100 @@ fn grabbed_nodes_follow_the_rules() {
         "grabs effect off"
     );
 }
+
+#[test]
+fn the_box_test_never_misses_a_node_inside_and_culls_far_shapes() {
+    // xorshift: deterministic points about the shapes, some far from the origin.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 40) as Real / (1u64 << 24) as Real * 2.0 - 1.0
+    };
+    let mut inside = 0;
+    for trial in 0..4000 {
+        let offset = Vec3::new(next(), next(), next()) * if trial % 2 == 0 { 0.5 } else { 50.0 };
+        let shape = match trial % 3 {
+            0 => Shape::Sphere {
+                centre: offset,
+                radius: 0.1,
+            },
+            1 => Shape::Capsule {
+                a: offset,
+                b: offset + Vec3::new(0.2, -0.1, 0.05),
+                radius: 0.03,
+            },
+            _ => Shape::Plane {
+                point: offset,
+                normal: Vec3::new(0.3, 0.9, -0.2).normalize(),
+            },
+        };
+        let p = offset + Vec3::new(next(), next(), next()) * 0.15;
+        if shape.penetration::<Libm>(p).is_some() {
+            inside += 1;
+            // The degenerate box of the point itself, and a box reaching away from it.
+            assert!(may_touch_box(&shape, p, p), "trial {trial}: {shape:?} {p}");
+            let far = p + Vec3::new(next(), next(), next()).abs();
+            assert!(may_touch_box(&shape, p.min(far), p.max(far)));
+        }
+    }
+    assert!(inside > 500, "only {inside} points inside");
+    // A box a metre away misses every bounded shape, and the half-space it is in front of.
+    let (low, high) = (Vec3::splat(1.0), Vec3::splat(1.3));
+    let sphere = Shape::Sphere {
+        centre: Vec3::ZERO,
+        radius: 0.1,
+    };
+    let capsule = Shape::Capsule {
+        a: Vec3::ZERO,
+        b: Vec3::X * 0.5,
+        radius: 0.1,
+    };
+    let floor = Shape::Plane {
+        point: Vec3::ZERO,
+        normal: Vec3::Y,
+    };
+    for shape in [sphere, capsule, floor] {
+        assert!(!may_touch_box(&shape, low, high), "{shape:?}");
+    }
+}
+
+#[test]
+fn strands_far_from_a_collider_skip_it_and_strands_on_it_do_not() {
+    let shapes = [
+        (
+            0,
+            Shape::Sphere {
+                centre: Vec3::new(0.0, -1.0, 0.0),
+                radius: 0.1,
+            },
+        ),
+        (
+            1,
+            Shape::Plane {
+                point: Vec3::ZERO,
+                normal: Vec3::Y,
+            },
+        ),
+    ];
+    // Lying on the floor y = 0, 1 m above the ball: only the floor is near.
+    let mut strand = line(10, Vec3::new(0.0, 0.0, 0.0), Vec3::X);
+    shake_nodes(&mut strand, 0.002);
+    let mut work = Workspace::new(&strand, 10);
+    let mut near = NearColliders::new(&strand, &work.nodes, &shapes, true);
+    let found = near.shapes(&shapes);
+    assert_eq!(found.len(), 1);
+    assert_eq!(found[0].0, 1);
+    // After a move of 1 m the ball may be reached: it joins, in the step's order.
+    near.moved::<Libm>(1.0);
+    let found = near.shapes(&shapes);
+    assert_eq!(
+        found.iter().map(|s| s.0).collect::<std::vec::Vec<_>>(),
+        [0, 1]
+    );
+    // Prescribed everywhere: nothing to test.
+    work.nodes.inverse_mass = [0.0; N];
+    let mut none = NearColliders::new(&strand, &work.nodes, &shapes, true);
+    assert!(none.shapes(&shapes).is_empty());
+}
