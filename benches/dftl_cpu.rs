@@ -94,7 +94,19 @@ fn contexts(shape: bool, steps: u32) -> Vec<StepContext> {
         .collect()
 }
 
+/// Labels to run: the command line's arguments that are not options (all when none).
+fn wanted(label: &str) -> bool {
+    let filters: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    filters.is_empty() || filters.iter().any(|f| label.contains(f.as_str()))
+}
+
 fn measure(label: &str, vertices: usize, steps: u32, mut run: impl FnMut()) {
+    if !wanted(label) {
+        return;
+    }
     let (cpu0, wall0) = (cpu_seconds(), Instant::now());
     run();
     let (cpu, wall) = (cpu_seconds() - cpu0, wall0.elapsed().as_secs_f64());

@@ -342,71 +342,21 @@ fn pass<
     );
     let mut measures: Measures<Wide<W>> = Measures::default();
     let mut previous_contact = Wide::<W>::mask(false);
+    // Nodes every lane has: there every lane is active and every selection below is a
+    // constant (the same bits as the masked form, without its blends).
+    let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
     for k in 2..max_nodes {
-        let (done, todo) = block.state.split_at_mut(k);
-        let (Some(previous), Some(state), Some(rest), Some(shape)) = (
-            done.last_mut(),
-            todo.first_mut(),
-            block.rest.get(k),
-            block.shape.get(k),
-        ) else {
-            break;
+        let carried = Carried {
+            chain: &mut chain,
+            measures: &mut measures,
+            previous_contact: &mut previous_contact,
+            poison: &mut poison,
         };
-        let node_index = Wide::splat(k as Real);
-        let active = node_index.lt(nodes_real);
-        // Node k − 1 exists in this lane and is free: it is finished now.
-        let finishing = Wide::<W>::mask(k > 2) & (node_index - Wide::splat(1.0)).lt(nodes_real);
-        let (extra, has_extra) = match accelerations {
-            None => (V3::zero(), Wide::<W>::mask(false)),
-            Some(a) => {
-                let mut extra: V3<Wide<W>> = V3::zero();
-                let mut has = [false; W];
-                for l in 0..W {
-                    if let Some(e) = a.get(l * N + k) {
-                        extra.x.0[l] = e.x;
-                        extra.y.0[l] = e.y;
-                        extra.z.0[l] = e.z;
-                        has[l] = true;
-                    }
-                }
-                (extra, WideMask(has))
-            }
-        };
-        let node = NodeInput {
-            position: load(&state.position),
-            velocity: load(&state.velocity),
-            extra,
-            has_extra,
-            inverse_mass: Wide(rest.inverse_mass),
-            rest_position: load(&shape.rest_position),
-            local_rest: load(&shape.local_rest),
-            root_distance: Wide(shape.root_distance),
-            segment_length: Wide(rest.segment_length),
-            strain_scale: Wide(rest.strain_scale),
-        };
-        // Lines 13–21, the per-strand path's function on every lane.
-        let next = advance::<M, Wide<W>>(
-            &setup,
-            ctx.colliders(),
-            &node,
-            &chain,
-            active,
-            previous_contact,
-            &mut measures,
-        );
-        // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
-        let next_correction = V3::select(active, next.correction, V3::zero());
-        let old_position = load(&previous.position);
-        let old_velocity = load(&previous.velocity);
-        let (x_new, v_new) =
-            velocity::finish(&setup, chain.position, old_position, next_correction);
-        let x_new = V3::select(finishing, x_new, old_position);
-        let v_new = V3::select(finishing, v_new, old_velocity);
-        store(&mut previous.position, x_new);
-        store(&mut previous.velocity, v_new);
-        poison = poison + not_finite(x_new) + not_finite(v_new);
-        chain = Chain::select(active, &next.chain, &chain);
-        previous_contact = (active & next.contact) | (!active & previous_contact);
+        if k > 2 && k < common {
+            node::<M, W, N, true>(ctx, &setup, block, k, nodes_real, accelerations, carried);
+        } else {
+            node::<M, W, N, false>(ctx, &setup, block, k, nodes_real, accelerations, carried);
+        }
     }
     // The last node of the longest lanes: no correction.
     if let Some(last) = block.state.get_mut(max_nodes - 1) {
@@ -438,4 +388,97 @@ fn pass<
         Tally::from_measures::<M>(&one).report(report, setup.collisions, setup.inv_dt);
     }
     core::array::from_fn(|l| poison.0[l] == 0.0)
+}
+
+/// What the node loop carries from node to node.
+struct Carried<'a, const W: usize> {
+    chain: &'a mut Chain<Wide<W>>,
+    measures: &'a mut Measures<Wide<W>>,
+    previous_contact: &'a mut WideMask<W>,
+    poison: &'a mut Wide<W>,
+}
+
+/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`.
+/// With `ALL` every lane has nodes `k − 1` and `k` (and `k > 2`): the masks are constants.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn node<M: Math, const W: usize, const N: usize, const ALL: bool>(
+    ctx: &StepContext,
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    k: usize,
+    nodes_real: Wide<W>,
+    accelerations: Option<&[Vec3]>,
+    carried: Carried<'_, W>,
+) {
+    let (done, todo) = block.state.split_at_mut(k);
+    let (Some(previous), Some(state), Some(rest), Some(shape)) = (
+        done.last_mut(),
+        todo.first_mut(),
+        block.rest.get(k),
+        block.shape.get(k),
+    ) else {
+        return;
+    };
+    let node_index = Wide::splat(k as Real);
+    let (active, finishing) = if ALL {
+        (Wide::<W>::mask(true), Wide::<W>::mask(true))
+    } else {
+        // Node k − 1 exists in this lane and is free: it is finished now.
+        (
+            node_index.lt(nodes_real),
+            Wide::<W>::mask(k > 2) & (node_index - Wide::splat(1.0)).lt(nodes_real),
+        )
+    };
+    let (extra, has_extra) = match accelerations {
+        None => (V3::zero(), Wide::<W>::mask(false)),
+        Some(a) => {
+            let mut extra: V3<Wide<W>> = V3::zero();
+            let mut has = [false; W];
+            for l in 0..W {
+                if let Some(e) = a.get(l * N + k) {
+                    extra.x.0[l] = e.x;
+                    extra.y.0[l] = e.y;
+                    extra.z.0[l] = e.z;
+                    has[l] = true;
+                }
+            }
+            (extra, WideMask(has))
+        }
+    };
+    let node = NodeInput {
+        position: load(&state.position),
+        velocity: load(&state.velocity),
+        extra,
+        has_extra,
+        inverse_mass: Wide(rest.inverse_mass),
+        rest_position: load(&shape.rest_position),
+        local_rest: load(&shape.local_rest),
+        root_distance: Wide(shape.root_distance),
+        segment_length: Wide(rest.segment_length),
+        strain_scale: Wide(rest.strain_scale),
+    };
+    // Lines 13–21, the per-strand path's function on every lane.
+    let next = advance::<M, Wide<W>>(
+        setup,
+        ctx.colliders(),
+        &node,
+        &*carried.chain,
+        active,
+        *carried.previous_contact,
+        carried.measures,
+    );
+    // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
+    let next_correction = V3::select(active, next.correction, V3::zero());
+    let old_position = load(&previous.position);
+    let old_velocity = load(&previous.velocity);
+    let (x_new, v_new) =
+        velocity::finish(setup, carried.chain.position, old_position, next_correction);
+    let x_new = V3::select(finishing, x_new, old_position);
+    let v_new = V3::select(finishing, v_new, old_velocity);
+    store(&mut previous.position, x_new);
+    store(&mut previous.velocity, v_new);
+    *carried.poison = *carried.poison + not_finite(x_new) + not_finite(v_new);
+    *carried.chain = Chain::select(active, &next.chain, carried.chain);
+    *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }

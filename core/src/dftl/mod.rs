@@ -16,12 +16,15 @@
 //! Lines 24–26 run one node behind (node `i − 1` is finished as soon as node `i`'s correction
 //! is known), so a step is a single pass whose cost is fixed by the scene.
 //!
-//! Measured behaviour of the correction as specified (eq. 14 feeding back the shape
-//! corrections too, `tests/dftl.rs`): with inextensibility only, `s_d = 0.9` removes the energy
-//! plain FTL pumps in (78 % of a swing's energy lost in 2 s, vs. plain FTL gaining up to 70×);
-//! with the shape constraints, feeding back `Δx^gbl_{i+1}` keeps a styled strand moving a few
-//! centimetres around its rest shape (with `s_g` alone and `s_d = 0` it settles to 2 µm), and
-//! with inextensibility *off*, shape + `s_d = 0.9` diverges (10^16 m within 3 s, measured).
+//! Eq. (14)'s velocity correction feeds back the local-shape and follow-the-leader
+//! corrections of the next node, not the global one: [`velocity`] says why and what was
+//! measured. With inextensibility only, `s_d = 0.9` removes the energy plain FTL pumps in (78 %
+//! of a swing's energy lost in 2 s, vs. plain FTL gaining up to 70×).
+//!
+//! Frames are carried as tangent and normal vectors ([`frame`]): with the tangent taken from
+//! the follow-the-leader step, a node costs one square root and, with shape, two divisions;
+//! segment strain is measured as `(|e|² − l²)/(2l²)` (no square root) and turned into a
+//! relative stretch once per strand.
 //!
 //! Two forms give the same bits: [`step`] on one `Strand<N>`, and [`block::step_block`] on a
 //! structure-of-arrays block of `W` strands, node index `k` of every lane together, calling
@@ -320,17 +323,23 @@ pub fn advance<M: Math, T: Lane>(
     let e = x - chain.position;
     let squared_length = e.dot(e);
     let strain = (squared_length - node.segment_length * node.segment_length) * node.strain_scale;
-    let touched = contact | previous_contact;
-    let free = active & !touched;
-    let pushed = active & touched;
-    measures.stretched = measures.stretched.max(T::select(free, strain, zero));
-    measures.compressed = measures.compressed.max(T::select(free, -strain, zero));
-    measures.contact_stretched = measures
-        .contact_stretched
-        .max(T::select(pushed, strain, zero));
-    measures.contact_compressed = measures
-        .contact_compressed
-        .max(T::select(pushed, -strain, zero));
+    if setup.collisions {
+        let touched = contact | previous_contact;
+        let free = active & !touched;
+        let pushed = active & touched;
+        measures.stretched = measures.stretched.max(T::select(free, strain, zero));
+        measures.compressed = measures.compressed.max(T::select(free, -strain, zero));
+        measures.contact_stretched = measures
+            .contact_stretched
+            .max(T::select(pushed, strain, zero));
+        measures.contact_compressed = measures
+            .contact_compressed
+            .max(T::select(pushed, -strain, zero));
+    } else {
+        // No collider, no contact: the contact extremes stay 0 in both forms.
+        measures.stretched = measures.stretched.max(T::select(active, strain, zero));
+        measures.compressed = measures.compressed.max(T::select(active, -strain, zero));
+    }
     // Line 21: the frame, carried only when the shape constraints need it. The tangent from
     // follow-the-leader holds unless a collider moved the node (or there was no projection).
     let next = if setup.shape {
