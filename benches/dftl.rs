@@ -133,6 +133,10 @@ fn bench_size<const N: usize>(c: &mut Criterion, count: usize) {
                 black_box(report.max_stretch)
             })
         });
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of two threads");
         group.bench_function(BenchmarkId::new("block-16 2 threads", label), |b| {
             b.iter(|| {
                 let ctx = &contexts[k % 64];
@@ -141,9 +145,14 @@ fn bench_size<const N: usize>(c: &mut Criterion, count: usize) {
                 let (left, right) = blocks.split_at_mut(half);
                 let mut reports = [StepReport::default(), StepReport::default()];
                 let (ra, rb) = reports.split_at_mut(1);
-                std::thread::scope(|scope| {
-                    scope.spawn(|| step_blocks::<HostMath, W, N>(ctx, left, 0, None, &mut ra[0]));
-                    step_blocks::<HostMath, W, N>(ctx, right, (half * W) as u32, None, &mut rb[0]);
+                pool.install(|| {
+                    rayon::join(
+                        || step_blocks::<HostMath, W, N>(ctx, left, 0, None, &mut ra[0]),
+                        || {
+                            let first = (half * W) as u32;
+                            step_blocks::<HostMath, W, N>(ctx, right, first, None, &mut rb[0])
+                        },
+                    )
                 });
                 let [mut a, b2] = reports;
                 a.merge(&b2);

@@ -3,7 +3,8 @@
 //! process used (Linux `/proc/self/stat` utime + stime, 10 ms ticks; runs last ≥ 0.3 s), and by
 //! the wall time. Sizes of Sánchez-Banderas 2015 Table 2; per-strand path vs blocks of 8 and 16
 //! lanes, DFTL (gravity + inextensibility) and DFTL + shape; the 16-lane blocks also split over
-//! two threads by a fixed partition (CPU time then counts both threads).
+//! two threads (a rayon pool, a fixed partition; CPU time then counts both threads).
+//! Arguments that are not options select cases whose label contains them.
 //!
 //! `cargo bench -p hairsim-benches --bench dftl_cpu`
 
@@ -94,7 +95,19 @@ fn contexts(shape: bool, steps: u32) -> Vec<StepContext> {
         .collect()
 }
 
+/// Labels to run: the command line's arguments that are not options (all when none).
+fn wanted(label: &str) -> bool {
+    let filters: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with("--"))
+        .collect();
+    filters.is_empty() || filters.iter().any(|f| label.contains(f.as_str()))
+}
+
 fn measure(label: &str, vertices: usize, steps: u32, mut run: impl FnMut()) {
+    if !wanted(label) {
+        return;
+    }
     let (cpu0, wall0) = (cpu_seconds(), Instant::now());
     run();
     let (cpu, wall) = (cpu_seconds() - cpu0, wall0.elapsed().as_secs_f64());
@@ -153,24 +166,32 @@ fn size<const N: usize>(count: usize, quick: bool) {
                 }
             },
         );
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .expect("a pool of two threads");
         measure(
             &format!("{count} x {N} block-16 2 threads {name}"),
             vertices,
             steps,
-            // A scoped thread per step (a harness without a pool), so both halves finish
-            // each step before the next starts.
+            // Two halves of the blocks on a pool of two threads (a fixed partition: the
+            // result does not depend on it), both finished before the next step starts.
             || {
                 let half = b16.len().div_ceil(2);
                 for c in &ctx {
-                    let (left, right) = b16.split_at_mut(half);
-                    std::thread::scope(|scope| {
-                        scope.spawn(|| {
-                            let mut r = StepReport::default();
-                            step_blocks::<HostMath, 16, N>(c, left, 0, None, &mut r);
-                        });
-                        let mut r = StepReport::default();
-                        let first = (half * 16) as u32;
-                        step_blocks::<HostMath, 16, N>(c, right, first, None, &mut r);
+                    pool.install(|| {
+                        let (left, right) = b16.split_at_mut(half);
+                        rayon::join(
+                            || {
+                                let mut r = StepReport::default();
+                                step_blocks::<HostMath, 16, N>(c, left, 0, None, &mut r);
+                            },
+                            || {
+                                let mut r = StepReport::default();
+                                let first = (half * 16) as u32;
+                                step_blocks::<HostMath, 16, N>(c, right, first, None, &mut r);
+                            },
+                        )
                     });
                 }
             },
@@ -179,10 +200,41 @@ fn size<const N: usize>(count: usize, quick: bool) {
     }
 }
 
+/// The state hash of 64 strands × 32 nodes after 200 shaking steps of DFTL + shape, by the
+/// per-strand path and by 16-lane blocks. Recorded on the default x86-64 target; the check
+/// that `-C target-cpu=native` (AVX-512 here) gives the same bits.
+const EXPECTED_HASH: u64 = 0x9928_fb52_bb00_f971;
+
+fn check_hash() {
+    let ctx = contexts(true, 200);
+    let mut s = strands::<32>(64);
+    let mut blocks: Vec<DftlBlock<16, 32>> = s.chunks(16).map(DftlBlock::from_strands).collect();
+    let mut report = StepReport::default();
+    for c in &ctx {
+        step_strands::<HostMath, 32>(c, &mut s, 0, &[], None, &mut report);
+        step_blocks::<HostMath, 16, 32>(c, &mut blocks, 0, None, &mut report);
+    }
+    let per_strand = hairsim_core::hash::state_hash(&s);
+    for (block, chunk) in blocks.iter().zip(s.chunks_mut(16)) {
+        block.store(chunk);
+    }
+    let block = hairsim_core::hash::state_hash(&s);
+    println!("state hash (64 x 32, 200 steps, shape): per-strand {per_strand:#018x}, block-16 {block:#018x}, recorded {EXPECTED_HASH:#018x}");
+    assert_eq!(
+        per_strand, block,
+        "block path differs from the per-strand path"
+    );
+    assert_eq!(
+        per_strand, EXPECTED_HASH,
+        "the bits changed with the build (target features?)"
+    );
+}
+
 fn main() {
     if std::env::args().any(|a| a == "--list") {
         return;
     }
+    check_hash();
     // `cargo bench` passes `--bench`; `cargo test --benches` does not: then every case runs
     // once, as a test that the benchmark works, not a measurement.
     let quick = !std::env::args().any(|a| a == "--bench");

@@ -149,10 +149,10 @@ fn distance_from_rest<const M: usize>(s: &Strand<M>) -> Real {
 /// after 3 s). With the shape constraints off, under gravity the same strands hang: their tips
 /// drop by more than 5 cm (measured 18–36 cm).
 ///
-/// Measured and NOT asserted as recovery: with the paper's defaults (`s_l` = 0.3, `s_d` = 0.9)
-/// the same strands keep moving 3–7 cm from their rest shape for the whole 3 s (local-only:
-/// 10–20 cm); the `s_d` feedback of the one-sided shape corrections sustains the motion. Only
-/// boundedness is asserted for that case below.
+/// With the paper's defaults (`s_g` = 0.1, `s_l` = 0.3 at 16 ms, `s_d` = 0.9) the same strands
+/// come back to within 3 cm after 3 s (measured 2.3 cm; 3–7 cm when eq. (14) also fed back the
+/// global correction, see `core/src/dftl/velocity.rs`): the one-sided local constraint keeps
+/// some motion going, slowly. Asserted: within 3 cm.
 #[test]
 fn shape_constraints_bring_styled_strands_back() {
     let mut p = dftl(&[Effect::Shape, Effect::Inextensibility]);
@@ -203,7 +203,7 @@ fn shape_constraints_bring_styled_strands_back() {
         .map(distance_from_rest)
         .fold(0.0, Real::max);
     println!("paper defaults: {bounded} m from the rest shape after 3 s");
-    assert!(bounded < 0.15, "{bounded}");
+    assert!(bounded < 0.03, "{bounded}");
 
     let mut hanging = world::<Libm>(dftl(&[Effect::Gravity, Effect::Inextensibility]), 8, N);
     for _ in 0..2000 {
@@ -280,7 +280,7 @@ fn damping_term_measured_energy_decay() {
 }
 
 fn collision_world<M: Math>() -> Box<World<8, N, M>> {
-    let p = Params {
+    let mut p = Params {
         drag: 2.0e-7,
         ..dftl(&[
             Effect::Gravity,
@@ -291,6 +291,8 @@ fn collision_world<M: Math>() -> Box<World<8, N, M>> {
             Effect::Collisions,
         ])
     };
+    // Local shape only: held up by their global shape the styled strands never reach the neck.
+    p.dftl.global_shape = 0.0;
     let mut w = world::<M>(p, 8, N);
     w.add_collider(Collider {
         shape: Shape::Sphere {
@@ -349,6 +351,7 @@ fn nodes_stay_out_of_colliders() {
             }
         }
     }
+    println!("contacts over 2 s: {contacts}");
     assert!(contacts > 0, "the scene never touched a collider");
 }
 
@@ -412,6 +415,20 @@ fn block_path_is_bit_identical_to_per_strand() {
                 report.max_stretch.to_bits(),
                 block_report.max_stretch.to_bits()
             );
+            assert_eq!(
+                report.max_contact_stretch.to_bits(),
+                block_report.max_contact_stretch.to_bits()
+            );
+            for (a, b) in report
+                .collider_forces
+                .iter()
+                .zip(block_report.collider_forces)
+            {
+                assert_eq!(
+                    a.to_array().map(f32::to_bits),
+                    b.to_array().map(f32::to_bits)
+                );
+            }
         }
         let mut copy: Vec<Strand<N>> = w.strands().to_vec();
         for (block, chunk) in blocks.iter().zip(copy.chunks_mut(W)) {
@@ -502,5 +519,112 @@ fn wind_blows_on_both_solvers() {
             (v.z - 0.2).abs() < 0.02 && v.x.abs() < 1e-6,
             "{solver:?}: {v}"
         );
+    }
+}
+
+/// A strand lying on a floor pushes it down with its weight: the step report's collider force
+/// (`−Σ m Δx^push / Δt²`, as the rod solver reports it) equals the weight of the free nodes
+/// within 1 %, per-strand and block path alike.
+#[test]
+fn a_strand_on_the_floor_reports_its_weight_as_contact_force() {
+    let p = dftl(&[Effect::Gravity, Effect::Inextensibility, Effect::Collisions]);
+    let mut w: Box<World<1, N, Libm>> = Box::default();
+    w.configure(p).unwrap();
+    w.add_collider(Collider {
+        shape: Shape::Plane {
+            point: Vec3::new(0.0, -0.001, 0.0),
+            normal: Vec3::Y,
+        },
+        attached_to_head: false,
+    })
+    .unwrap();
+    let points: Vec<Vec3> = (0..20)
+        .map(|i| Vec3::new(0.01 * i as Real, 0.0, 0.0))
+        .collect();
+    w.add_strand(Strand::from_polyline(&points, &Material::HUMAN_HAIR).unwrap())
+        .unwrap();
+    let still = StepInput {
+        head: Pose::IDENTITY,
+        accelerations: None,
+    };
+    let mut report = StepReport::default();
+    for _ in 0..500 {
+        report = w.step(&still);
+    }
+    let weight: Real = w.strands()[0].rest.mass[2..20].iter().sum::<Real>() * 9.81;
+    let force = report.collider_forces[0];
+    println!("floor force {force}, free weight {weight}");
+    assert!(
+        (force.y + weight).abs() <= 0.01 * weight,
+        "{force} vs {weight}"
+    );
+    assert!(force.x.abs() + force.z.abs() <= 1e-3 * weight, "{force}");
+    assert!(report.contacts >= 17 && report.max_penetration <= 1e-7);
+}
+
+/// Blocks split over 1, 2 and 3 threads (a fixed partition of the blocks; each block steps
+/// into its own report, merged in block order) give the same state hash and the same report,
+/// bit for bit, forces included: the result does not depend on the thread count.
+#[test]
+fn block_path_result_does_not_depend_on_the_thread_count() {
+    const W: usize = 2;
+    fn run(threads: usize) -> (u64, Vec<StepReport>) {
+        let w = collision_world::<HostMath>();
+        let p = *w.params();
+        let mut blocks: Vec<DftlBlock<W, N>> =
+            w.strands().chunks(W).map(DftlBlock::from_strands).collect();
+        let coefficients = p.dftl.at_step(p.dt);
+        let mut previous = Pose::IDENTITY;
+        let mut reports = Vec::new();
+        for k in 0..400u32 {
+            let t = (k + 1) as Real * p.dt;
+            let head = Shake::TEN_RAD_PER_S.pose_at::<Libm>(t);
+            let ctx =
+                StepContext::with_coefficients(&p, coefficients, previous, head, w.colliders())
+                    .at_time(t);
+            previous = head;
+            let mut per_block = vec![StepReport::default(); blocks.len()];
+            let share = blocks.len().div_ceil(threads);
+            std::thread::scope(|scope| {
+                for (c, (chunk, out)) in blocks
+                    .chunks_mut(share)
+                    .zip(per_block.chunks_mut(share))
+                    .enumerate()
+                {
+                    let ctx = &ctx;
+                    scope.spawn(move || {
+                        for (b, (block, report)) in chunk.iter_mut().zip(out).enumerate() {
+                            let first = ((c * share + b) * W) as u32;
+                            step_blocks::<HostMath, W, N>(
+                                ctx,
+                                core::slice::from_mut(block),
+                                first,
+                                None,
+                                report,
+                            );
+                        }
+                    });
+                }
+            });
+            let mut report = StepReport::default();
+            for r in &per_block {
+                report.merge(r);
+            }
+            reports.push(report);
+        }
+        let mut copy: Vec<Strand<N>> = w.strands().to_vec();
+        for (block, chunk) in blocks.iter().zip(copy.chunks_mut(W)) {
+            block.store(chunk);
+        }
+        (hairsim_core::hash::state_hash(&copy), reports)
+    }
+    let (hash, reports) = run(1);
+    assert!(reports.iter().any(|r| r.contacts > 0));
+    for threads in [2, 3] {
+        let (h, r) = run(threads);
+        assert_eq!(h, hash, "{threads} threads");
+        for (a, b) in reports.iter().zip(&r) {
+            assert_eq!(format!("{a:?}"), format!("{b:?}"), "{threads} threads");
+        }
     }
 }

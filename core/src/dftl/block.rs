@@ -20,12 +20,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::context::StepContext;
-use crate::math::{Math, Quat, Real, Vec3};
+use crate::math::{Math, Real, Vec3};
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
-use super::lane::{Lane, Wide, WideMask, Q, V3};
-use super::{collisions, project_node, velocity, Chain, NodeInput, Setup, Tally};
+use super::lane::{Lane, Wide, WideMask, V3};
+use super::{advance, velocity, Chain, Measures, NodeInput, Setup, Tally};
 
 /// Lanes per block the harness should use on x86-64: measured fastest — on the SSE2 baseline
 /// 16 lanes ran ≈ 2.5× faster than 8 and than 32 (both spill far more), and with
@@ -55,6 +55,8 @@ pub struct RestLanes<const W: usize> {
     pub segment_length: Lanes<W>,
     /// `1/m_k`.
     pub inverse_mass: Lanes<W>,
+    /// `1/(2 l_k²)` (0 for `k = 0`).
+    pub strain_scale: Lanes<W>,
 }
 
 /// Rest data of node `k` the shape constraints (and root coupling) read.
@@ -77,8 +79,10 @@ pub struct DftlBlock<const W: usize, const N: usize> {
     pub nodes: [usize; W],
     /// The largest node count.
     pub max_nodes: usize,
-    /// `R̂_0` of each lane: x, y, z, w.
-    pub root_frame: [Lanes<W>; 4],
+    /// `t̂_0 = R̂_0 e_x` of each lane.
+    pub root_tangent: VecLanes<W>,
+    /// `n̂_0 = R̂_0 e_y` of each lane.
+    pub root_normal: VecLanes<W>,
     /// State per node.
     pub state: [StateLanes<W>; N],
     /// Rest data per node.
@@ -115,7 +119,8 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
             strands: 0,
             nodes: [0; W],
             max_nodes: 0,
-            root_frame: [[0.0; W], [0.0; W], [0.0; W], [1.0; W]],
+            root_tangent: zero,
+            root_normal: zero,
             state: [StateLanes {
                 position: zero,
                 velocity: zero,
@@ -123,6 +128,7 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
             rest: [RestLanes {
                 segment_length: [0.0; W],
                 inverse_mass: [0.0; W],
+                strain_scale: [0.0; W],
             }; N],
             shape: [ShapeLanes {
                 rest_position: zero,
@@ -142,10 +148,8 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
             let n = strand.rest.nodes.min(N);
             self.nodes[l] = n;
             self.max_nodes = self.max_nodes.max(n);
-            let q = strand.rest.dftl.root_frame;
-            for (axis, value) in self.root_frame.iter_mut().zip([q.x, q.y, q.z, q.w]) {
-                axis[l] = value;
-            }
+            set(&mut self.root_tangent, l, strand.rest.dftl.root_tangent);
+            set(&mut self.root_normal, l, strand.rest.dftl.root_normal);
             for k in 0..n {
                 let state = &mut self.state[k];
                 set(&mut state.position, l, strand.state.position[k]);
@@ -157,6 +161,7 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
                     0.0
                 };
                 rest.inverse_mass[l] = strand.rest.inverse_mass[k];
+                rest.strain_scale[l] = strand.rest.dftl.strain_scale[k];
                 let shape = &mut self.shape[k];
                 set(&mut shape.rest_position, l, strand.rest.position[k]);
                 set(&mut shape.local_rest, l, strand.rest.dftl.local_rest[k]);
@@ -328,122 +333,30 @@ fn pass<
     if max_nodes < 3 {
         return core::array::from_fn(|l| poison.0[l] == 0.0);
     }
-    // The chain at node 1, lane by lane with the per-strand path's scalar code.
-    let mut chain: Chain<Wide<W>> = Chain {
-        position: V3::splat(Vec3::ZERO),
-        frame: Q::splat(Quat::IDENTITY),
-        tangent: V3::splat(Vec3::ZERO),
-    };
-    for l in 0..W {
-        let f = &block.root_frame;
-        let root_frame = Quat::from_xyzw(f[0][l], f[1][l], f[2][l], f[3][l]);
-        let x0 = get(&block.state[0].position, l);
-        let x1 = get(&block.state[1].position, l);
-        let start = Chain::start::<M>(&setup, root_frame, x0, x1);
-        for (wide, scalar) in [
-            (&mut chain.position.x, start.position.x),
-            (&mut chain.position.y, start.position.y),
-            (&mut chain.position.z, start.position.z),
-            (&mut chain.frame.x, start.frame.x),
-            (&mut chain.frame.y, start.frame.y),
-            (&mut chain.frame.z, start.frame.z),
-            (&mut chain.frame.w, start.frame.w),
-            (&mut chain.tangent.x, start.tangent.x),
-            (&mut chain.tangent.y, start.tangent.y),
-            (&mut chain.tangent.z, start.tangent.z),
-        ] {
-            wide.0[l] = scalar;
-        }
-    }
-    let mut stretch = zero;
-    let mut contact_stretch = zero;
-    let mut penetration = zero;
-    let mut contacts = zero;
+    // The chain at node 1: `R_head R̂_0`, all lanes at once.
+    let mut chain = Chain::start(
+        &setup,
+        load(&block.root_tangent),
+        load(&block.root_normal),
+        load(&block.state[1].position),
+    );
+    let mut measures: Measures<Wide<W>> = Measures::default();
     let mut previous_contact = Wide::<W>::mask(false);
+    // Nodes every lane has: there every lane is active and every selection below is a
+    // constant (the same bits as the masked form, without its blends).
+    let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
     for k in 2..max_nodes {
-        let (done, todo) = block.state.split_at_mut(k);
-        let (Some(previous), Some(state), Some(rest), Some(shape)) = (
-            done.last_mut(),
-            todo.first_mut(),
-            block.rest.get(k),
-            block.shape.get(k),
-        ) else {
-            break;
+        let carried = Carried {
+            chain: &mut chain,
+            measures: &mut measures,
+            previous_contact: &mut previous_contact,
+            poison: &mut poison,
         };
-        let node_index = Wide::splat(k as Real);
-        let active = node_index.lt(nodes_real);
-        // Node k − 1 exists in this lane and is free: it is finished now.
-        let finishing = Wide::<W>::mask(k > 2) & (node_index - Wide::splat(1.0)).lt(nodes_real);
-        let (extra, has_extra) = match accelerations {
-            None => (V3::zero(), Wide::<W>::mask(false)),
-            Some(a) => {
-                let mut extra: V3<Wide<W>> = V3::zero();
-                let mut has = [false; W];
-                for l in 0..W {
-                    if let Some(e) = a.get(l * N + k) {
-                        extra.x.0[l] = e.x;
-                        extra.y.0[l] = e.y;
-                        extra.z.0[l] = e.z;
-                        has[l] = true;
-                    }
-                }
-                (extra, WideMask(has))
-            }
-        };
-        let node = NodeInput {
-            position: load(&state.position),
-            velocity: load(&state.velocity),
-            extra,
-            has_extra,
-            inverse_mass: Wide(rest.inverse_mass),
-            rest_position: load(&shape.rest_position),
-            local_rest: load(&shape.local_rest),
-            root_distance: Wide(shape.root_distance),
-            segment_length: Wide(rest.segment_length),
-        };
-        // Lines 13–19: predict, shape, follow the leader.
-        let (mut x, correction) = project_node::<M, Wide<W>>(&setup, &node, &chain);
-        // Line 20: collisions, one collider over all lanes at a time (the per-strand path's
-        // order of colliders, so the same bits), then what is left inside.
-        let mut contact = Wide::<W>::mask(false);
-        if setup.collisions {
-            for collider in ctx.colliders() {
-                let (pushed, inside) = collisions::push_out::<M, Wide<W>>(collider, x);
-                x = pushed;
-                contact = contact | inside;
-            }
-            for collider in ctx.colliders() {
-                let depth = collisions::depth::<M, Wide<W>>(collider, x);
-                penetration = penetration.max(Wide::select(active, depth, zero));
-            }
-            contacts = contacts + Wide::select(active & contact, Wide::splat(1.0), zero);
-        }
-        // Line 21: frames, and the segment's stretch with or without contact.
-        let (next, s) = chain.advance::<M>(&setup, x, node.segment_length);
-        let touched = contact | previous_contact;
-        stretch = stretch.max(Wide::select(active & !touched, s, zero));
-        contact_stretch = contact_stretch.max(Wide::select(active & touched, s, zero));
-        // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
-        let next_correction = V3::select(active, correction, V3::zero());
-        let old_position = load(&previous.position);
-        let old_velocity = load(&previous.velocity);
-        let (x_new, v_new) =
-            velocity::finish(&setup, chain.position, old_position, next_correction);
-        let x_new = V3::select(finishing, x_new, old_position);
-        let v_new = V3::select(finishing, v_new, old_velocity);
-        store(&mut previous.position, x_new);
-        store(&mut previous.velocity, v_new);
-        poison = poison + not_finite(x_new) + not_finite(v_new);
-        chain = if SHAPE {
-            Chain::select(active, &next, &chain)
+        if k > 2 && k < common {
+            node::<M, W, N, true>(ctx, &setup, block, k, nodes_real, accelerations, carried);
         } else {
-            // Without shape the frames never change: carry the position only.
-            Chain {
-                position: V3::select(active, next.position, chain.position),
-                ..chain
-            }
-        };
-        previous_contact = (active & contact) | (!active & previous_contact);
+            node::<M, W, N, false>(ctx, &setup, block, k, nodes_real, accelerations, carried);
+        }
     }
     // The last node of the longest lanes: no correction.
     if let Some(last) = block.state.get_mut(max_nodes - 1) {
@@ -458,13 +371,114 @@ fn pass<
         poison = poison + not_finite(x_new) + not_finite(v_new);
     }
     for l in 0..block.strands.min(W) {
-        Tally {
-            stretch: stretch.0[l],
-            contact_stretch: contact_stretch.0[l],
-            penetration: penetration.0[l],
-            contacts: contacts.0[l] as u32,
-        }
-        .report(report);
+        let lane = |v: V3<Wide<W>>| V3 {
+            x: v.x.0[l],
+            y: v.y.0[l],
+            z: v.z.0[l],
+        };
+        let one = Measures {
+            stretched: measures.stretched.0[l],
+            compressed: measures.compressed.0[l],
+            contact_stretched: measures.contact_stretched.0[l],
+            contact_compressed: measures.contact_compressed.0[l],
+            penetration: measures.penetration.0[l],
+            contacts: measures.contacts.0[l],
+            collider_push: measures.collider_push.map(lane),
+        };
+        Tally::from_measures::<M>(&one).report(report, setup.collisions, setup.inv_dt);
     }
     core::array::from_fn(|l| poison.0[l] == 0.0)
+}
+
+/// What the node loop carries from node to node.
+struct Carried<'a, const W: usize> {
+    chain: &'a mut Chain<Wide<W>>,
+    measures: &'a mut Measures<Wide<W>>,
+    previous_contact: &'a mut WideMask<W>,
+    poison: &'a mut Wide<W>,
+}
+
+/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`.
+/// With `ALL` every lane has nodes `k − 1` and `k` (and `k > 2`): the masks are constants.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn node<M: Math, const W: usize, const N: usize, const ALL: bool>(
+    ctx: &StepContext,
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    k: usize,
+    nodes_real: Wide<W>,
+    accelerations: Option<&[Vec3]>,
+    carried: Carried<'_, W>,
+) {
+    let (done, todo) = block.state.split_at_mut(k);
+    let (Some(previous), Some(state), Some(rest), Some(shape)) = (
+        done.last_mut(),
+        todo.first_mut(),
+        block.rest.get(k),
+        block.shape.get(k),
+    ) else {
+        return;
+    };
+    let node_index = Wide::splat(k as Real);
+    let (active, finishing) = if ALL {
+        (Wide::<W>::mask(true), Wide::<W>::mask(true))
+    } else {
+        // Node k − 1 exists in this lane and is free: it is finished now.
+        (
+            node_index.lt(nodes_real),
+            Wide::<W>::mask(k > 2) & (node_index - Wide::splat(1.0)).lt(nodes_real),
+        )
+    };
+    let (extra, has_extra) = match accelerations {
+        None => (V3::zero(), Wide::<W>::mask(false)),
+        Some(a) => {
+            let mut extra: V3<Wide<W>> = V3::zero();
+            let mut has = [false; W];
+            for l in 0..W {
+                if let Some(e) = a.get(l * N + k) {
+                    extra.x.0[l] = e.x;
+                    extra.y.0[l] = e.y;
+                    extra.z.0[l] = e.z;
+                    has[l] = true;
+                }
+            }
+            (extra, WideMask(has))
+        }
+    };
+    let node = NodeInput {
+        position: load(&state.position),
+        velocity: load(&state.velocity),
+        extra,
+        has_extra,
+        inverse_mass: Wide(rest.inverse_mass),
+        rest_position: load(&shape.rest_position),
+        local_rest: load(&shape.local_rest),
+        root_distance: Wide(shape.root_distance),
+        segment_length: Wide(rest.segment_length),
+        strain_scale: Wide(rest.strain_scale),
+    };
+    // Lines 13–21, the per-strand path's function on every lane.
+    let next = advance::<M, Wide<W>>(
+        setup,
+        ctx.colliders(),
+        &node,
+        &*carried.chain,
+        active,
+        *carried.previous_contact,
+        carried.measures,
+    );
+    // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
+    let next_correction = V3::select(active, next.correction, V3::zero());
+    let old_position = load(&previous.position);
+    let old_velocity = load(&previous.velocity);
+    let (x_new, v_new) =
+        velocity::finish(setup, carried.chain.position, old_position, next_correction);
+    let x_new = V3::select(finishing, x_new, old_position);
+    let v_new = V3::select(finishing, v_new, old_velocity);
+    store(&mut previous.position, x_new);
+    store(&mut previous.velocity, v_new);
+    *carried.poison = *carried.poison + not_finite(x_new) + not_finite(v_new);
+    *carried.chain = Chain::select(active, &next.chain, carried.chain);
+    *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }

@@ -6,17 +6,27 @@ use crate::math::Math;
 
 use super::lane::{Lane, V3};
 
-/// `Δx^inex_i = (1 − l_i / |x*_{i−1} − x*_i|)(x*_{i−1} − x*_i)`. Coincident nodes give no
-/// direction and no correction (a select, not a branch).
+/// `x*_i + Δx^inex_i = x*_{i−1} + l_i t_i` with `t_i = (x*_i − x*_{i−1}) / |x*_i − x*_{i−1}|`:
+/// eq. (10)'s `x*_i + (1 − l_i/|d|) d`, `d = x*_{i−1} − x*_i`, written so that the segment's
+/// unit direction `t_i` — which the frame update needs next — comes with it (one square root
+/// and one division per node, the inherent cost of follow-the-leader). Returns the projected
+/// node and `t_i`. Coincident nodes give no direction: the node stays and the tangent is
+/// `fallback` (a select, not a branch).
 #[inline(always)]
 #[must_use]
-pub fn correction<M: Math, T: Lane>(previous: V3<T>, x: V3<T>, segment_length: T) -> V3<T> {
-    let d = previous - x;
-    let length = d.dot(d).sqrt::<M>();
-    let k = T::select(
-        T::splat(0.0).lt(length),
-        T::splat(1.0) - segment_length / length,
-        T::splat(0.0),
-    );
-    d.scale(k)
+pub fn project<M: Math, T: Lane>(
+    previous: V3<T>,
+    x: V3<T>,
+    segment_length: T,
+    fallback: V3<T>,
+) -> (V3<T>, V3<T>) {
+    let e = x - previous;
+    let length = e.dot(e).sqrt::<M>();
+    let found = T::splat(0.0).lt(length);
+    let tangent = e.scale(T::splat(1.0) / length);
+    let projected = previous + tangent.scale(segment_length);
+    (
+        V3::select(found, projected, x),
+        V3::select(found, tangent, fallback),
+    )
 }

@@ -43,6 +43,9 @@ pub trait Lane:
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
     /// A mask with `value` in every lane.
     fn mask(value: bool) -> Self::Mask;
+    /// Whether every lane of `mask` is set (to skip work no lane needs: never to change a
+    /// lane's result, so a block and the per-strand path still give the same bits).
+    fn all(mask: Self::Mask) -> bool;
 }
 
 impl Lane for Real {
@@ -82,6 +85,10 @@ impl Lane for Real {
     #[inline(always)]
     fn mask(value: bool) -> bool {
         value
+    }
+    #[inline(always)]
+    fn all(mask: bool) -> bool {
+        mask
     }
 }
 
@@ -166,6 +173,10 @@ impl<const W: usize> Lane for Wide<W> {
     #[inline(always)]
     fn mask(value: bool) -> WideMask<W> {
         WideMask([value; W])
+    }
+    #[inline(always)]
+    fn all(mask: WideMask<W>) -> bool {
+        mask.0.iter().fold(true, |a, &b| a & b)
     }
 }
 

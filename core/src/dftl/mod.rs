@@ -16,12 +16,15 @@
 //! Lines 24–26 run one node behind (node `i − 1` is finished as soon as node `i`'s correction
 //! is known), so a step is a single pass whose cost is fixed by the scene.
 //!
-//! Measured behaviour of the correction as specified (eq. 14 feeding back the shape
-//! corrections too, `tests/dftl.rs`): with inextensibility only, `s_d = 0.9` removes the energy
-//! plain FTL pumps in (78 % of a swing's energy lost in 2 s, vs. plain FTL gaining up to 70×);
-//! with the shape constraints, feeding back `Δx^gbl_{i+1}` keeps a styled strand moving a few
-//! centimetres around its rest shape (with `s_g` alone and `s_d = 0` it settles to 2 µm), and
-//! with inextensibility *off*, shape + `s_d = 0.9` diverges (10^16 m within 3 s, measured).
+//! Eq. (14)'s velocity correction feeds back the local-shape and follow-the-leader
+//! corrections of the next node, not the global one: [`velocity`] says why and what was
+//! measured. With inextensibility only, `s_d = 0.9` removes the energy plain FTL pumps in (78 %
+//! of a swing's energy lost in 2 s, vs. plain FTL gaining up to 70×).
+//!
+//! Frames are carried as tangent and normal vectors ([`frame`]): with the tangent taken from
+//! the follow-the-leader step, a node costs one square root and, with shape, two divisions;
+//! segment strain is measured as `(|e|² − l²)/(2l²)` (no square root) and turned into a
+//! relative stretch once per strand.
 //!
 //! Two forms give the same bits: [`step`] on one `Strand<N>`, and [`block::step_block`] on a
 //! structure-of-arrays block of `W` strands, node index `k` of every lane together, calling
@@ -41,14 +44,15 @@ pub mod velocity;
 pub use block::{step_block, step_blocks, DftlBlock, RECOMMENDED_LANES};
 pub use rest::DftlRest;
 
+use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
-use crate::math::{self, Mat3, Math, Quat, Real, Vec3};
+use crate::math::{Mat3, Math, Real, Vec3};
 use crate::params::DftlCoefficients;
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
-use lane::{Lane, Q, V3};
+use lane::{Lane, V3};
 
 /// Everything a DFTL step derives once from the context and shares by every strand and lane.
 #[derive(Clone, Copy, Debug)]
@@ -75,10 +79,8 @@ pub struct Setup {
     pub collisions: bool,
     /// `s_g`, `s_l`, `s_d` at this `dt`.
     pub coefficients: DftlCoefficients,
-    /// The head's rotation as a matrix (global targets).
+    /// The head's rotation as a matrix (global targets, root frame).
     pub head_rotation: Mat3,
-    /// The head's rotation (root frame).
-    pub head_quaternion: Quat,
     /// The head's translation.
     pub head_position: Vec3,
 }
@@ -87,7 +89,6 @@ impl Setup {
     /// The setup of the step described by `ctx`.
     #[must_use]
     pub fn new(ctx: &StepContext) -> Self {
-        let q = ctx.head.rotation;
         Setup {
             dt: ctx.dt,
             dt_squared: ctx.dt * ctx.dt,
@@ -100,10 +101,19 @@ impl Setup {
             inextensibility: ctx.has(Effect::Inextensibility),
             collisions: !ctx.colliders().is_empty(),
             coefficients: ctx.dftl,
-            head_rotation: Mat3::from_quat(q),
-            head_quaternion: q,
+            head_rotation: Mat3::from_quat(ctx.head.rotation),
             head_position: ctx.head.position,
         }
+    }
+
+    /// `R_head v`, summed column by column as glam's `Mat3 * Vec3`.
+    #[inline(always)]
+    #[must_use]
+    pub fn head_rotate<T: Lane>(&self, v: V3<T>) -> V3<T> {
+        let r = &self.head_rotation;
+        V3::splat(r.x_axis).scale(v.x)
+            + V3::splat(r.y_axis).scale(v.y)
+            + V3::splat(r.z_axis).scale(v.z)
     }
 
     /// Counts `strands` strands through the stages that run.
@@ -153,61 +163,31 @@ pub struct NodeInput<T: Lane> {
     pub root_distance: T,
     /// `l_i = |x̂_i − x̂_{i−1}|`.
     pub segment_length: T,
+    /// `1/(2 l_i²)`.
+    pub strain_scale: T,
 }
 
-/// What node `i` needs of the final node `i − 1`: its position, frame and unit incoming edge.
+/// What node `i` needs of the final node `i − 1`: its position and frame `(t, n, t × n)`.
 #[derive(Clone, Copy, Debug)]
 pub struct Chain<T> {
     /// `x*_{i−1}`, final.
     pub position: V3<T>,
-    /// `R_{i−1}`.
-    pub frame: Q<T>,
-    /// `t_{i−1}`, the x-axis of `R_{i−1}`.
+    /// `t_{i−1} = R_{i−1} e_x`, the unit incoming edge.
     pub tangent: V3<T>,
-}
-
-impl Chain<Real> {
-    /// The chain at node 1 from the held nodes 0 and 1: `R_1 = R_0 = q_head · R̂_0`.
-    #[must_use]
-    pub fn start<M: Math>(setup: &Setup, root_frame: Quat, x0: Vec3, x1: Vec3) -> Self {
-        let frame = math::quat_normalize::<M>(math::quat_mul(setup.head_quaternion, root_frame));
-        let edge = x1 - x0;
-        let length = M::sqrt(edge.dot(edge));
-        let tangent = if length > 0.0 {
-            edge * (1.0 / length)
-        } else {
-            math::rotate(frame, Vec3::X)
-        };
-        Chain {
-            position: x1.into(),
-            frame: frame.into(),
-            tangent: tangent.into(),
-        }
-    }
+    /// `n_{i−1} = R_{i−1} e_y`.
+    pub normal: V3<T>,
 }
 
 impl<T: Lane> Chain<T> {
-    /// Moves the chain on to the final node `x` (line 21: the frame is carried only when the
-    /// shape constraints need it) and returns the segment's relative stretch `| |e| − l | / l`.
+    /// The chain at node 1 (held by the head): `R_1 = R_0 = R_head R̂_0`, given by its columns.
     #[inline(always)]
     #[must_use]
-    pub fn advance<M: Math>(&self, setup: &Setup, x: V3<T>, segment_length: T) -> (Chain<T>, T) {
-        let edge = x - self.position;
-        let length = edge.dot(edge).sqrt::<M>();
-        let stretch = (length - segment_length).abs() / segment_length;
-        let (frame, tangent) = if setup.shape {
-            frame::transport::<M, T>(self.frame, self.tangent, edge, length)
-        } else {
-            (self.frame, self.tangent)
-        };
-        (
-            Chain {
-                position: x,
-                frame,
-                tangent,
-            },
-            stretch,
-        )
+    pub fn start(setup: &Setup, root_tangent: V3<T>, root_normal: V3<T>, x1: V3<T>) -> Self {
+        Chain {
+            position: x1,
+            tangent: setup.head_rotate(root_tangent),
+            normal: setup.head_rotate(root_normal),
+        }
     }
 
     /// Per lane `if mask { a } else { b }`.
@@ -216,21 +196,75 @@ impl<T: Lane> Chain<T> {
     pub fn select(mask: T::Mask, a: &Self, b: &Self) -> Self {
         Chain {
             position: V3::select(mask, a.position, b.position),
-            frame: Q::select(mask, a.frame, b.frame),
             tangent: V3::select(mask, a.tangent, b.tangent),
+            normal: V3::select(mask, a.normal, b.normal),
         }
     }
 }
 
-/// Lines 13–14 and 18–19 for one node: the predicted position after shape and inextensibility,
-/// and the total correction `Δx^gbl + Δx^lcl + Δx^inex` that eq. (14) feeds back.
+/// What a step measures along the way, per lane: strain extremes, penetration, contacts and
+/// the momentum the colliders gave each node. Nothing is ever summed across lanes; sums run
+/// along each strand in node order in both paths, so they are the same bits.
+#[derive(Clone, Copy, Debug)]
+pub struct Measures<T> {
+    /// Largest strain `(|e|² − l²)/(2 l²)` of a segment without contact (≥ 0).
+    pub stretched: T,
+    /// Largest `−strain` of a segment without contact (≥ 0).
+    pub compressed: T,
+    /// Largest strain of a segment with a pushed node.
+    pub contact_stretched: T,
+    /// Largest `−strain` of a segment with a pushed node.
+    pub contact_compressed: T,
+    /// Deepest node left inside a collider.
+    pub penetration: T,
+    /// Nodes pushed out.
+    pub contacts: T,
+    /// `Σ m Δx^push` per collider (the push-outs, mass weighted).
+    pub collider_push: [V3<T>; MAX_COLLIDERS],
+}
+
+impl<T: Lane> Default for Measures<T> {
+    fn default() -> Self {
+        let zero = T::splat(0.0);
+        Measures {
+            stretched: zero,
+            compressed: zero,
+            contact_stretched: zero,
+            contact_compressed: zero,
+            penetration: zero,
+            contacts: zero,
+            collider_push: [V3::zero(); MAX_COLLIDERS],
+        }
+    }
+}
+
+/// The outcome of [`advance`] for one node.
+#[derive(Clone, Copy, Debug)]
+pub struct Advanced<T: Lane> {
+    /// The chain at this node (its final position and frame).
+    pub chain: Chain<T>,
+    /// `Δx^lcl_i + Δx^inex_i`, fed back into node `i − 1`'s velocity (eq. 14).
+    pub correction: V3<T>,
+    /// Whether a collider pushed the node.
+    pub contact: T::Mask,
+}
+
+/// SB15 Algorithm 1 lines 13–21 for node `i` of every lane where `active` (a lane past its
+/// last node computes but adds nothing): predict, shape, follow the leader, collisions, the
+/// segment's strain, the frame. One function for the per-strand path (`T = Real`, `active`
+/// true) and the block path, so both run the same operations per strand.
 #[inline(always)]
 #[must_use]
-pub fn project_node<M: Math, T: Lane>(
+pub fn advance<M: Math, T: Lane>(
     setup: &Setup,
+    colliders: &[Shape],
     node: &NodeInput<T>,
     chain: &Chain<T>,
-) -> (V3<T>, V3<T>) {
+    active: T::Mask,
+    previous_contact: T::Mask,
+    measures: &mut Measures<T>,
+) -> Advanced<T> {
+    let zero = T::splat(0.0);
     // Lines 13–14: external accelerations, prediction (eq. 1).
     let a = predict::acceleration(
         setup,
@@ -240,52 +274,156 @@ pub fn project_node<M: Math, T: Lane>(
         node.has_extra,
     );
     let mut x = predict::predicted_position(setup, node.position, node.velocity, a);
-    let mut correction = V3::zero();
     // Line 18: shape, eqs. (8), (9) — the local target uses x* after the global step.
+    // Eq. (14) feeds back the local and the follow-the-leader corrections, not the global
+    // one (see [`velocity`] for why).
+    let mut correction = V3::zero();
     if setup.shape {
-        let global = shape::global_correction(setup, node.rest_position, node.root_distance, x);
-        x = x + global;
-        let local = shape::local_correction(
+        x = x + shape::global_correction(setup, node.rest_position, node.root_distance, x);
+        correction = shape::local_correction(
             setup,
             chain.position,
-            chain.frame,
+            chain.tangent,
+            chain.normal,
             node.local_rest,
             node.root_distance,
             x,
         );
-        x = x + local;
-        correction = global + local;
+        x = x + correction;
     }
-    // Line 19: follow the leader, eq. (10).
+    // Line 19: follow the leader, eq. (10); its direction is the frame's next tangent.
+    let mut tangent = chain.tangent;
+    let mut tangent_known = T::mask(false);
     if setup.inextensibility {
-        let inextensible =
-            follow_leader::correction::<M, T>(chain.position, x, node.segment_length);
-        x = x + inextensible;
-        correction = correction + inextensible;
+        let (projected, t) =
+            follow_leader::project::<M, T>(chain.position, x, node.segment_length, chain.tangent);
+        correction = correction + (projected - x);
+        x = projected;
+        tangent = t;
+        tangent_known = T::mask(true);
     }
-    (x, correction)
+    // Line 20: collisions (each collider in turn), then what is left inside.
+    let mut contact = T::mask(false);
+    if setup.collisions {
+        let mass = T::splat(1.0) / node.inverse_mass;
+        for (shape, push) in colliders.iter().zip(measures.collider_push.iter_mut()) {
+            let (pushed, inside) = collisions::push_out::<M, T>(shape, x);
+            *push = *push + V3::select(active, (pushed - x).scale(mass), V3::zero());
+            x = pushed;
+            contact = contact | inside;
+        }
+        for shape in colliders {
+            let depth = collisions::depth::<M, T>(shape, x);
+            measures.penetration = measures.penetration.max(T::select(active, depth, zero));
+        }
+        measures.contacts = measures.contacts + T::select(active & contact, T::splat(1.0), zero);
+    }
+    // The segment's strain, no square root: `(|e|² − l²)/(2l²) = δ + δ²/2` for the relative
+    // stretch δ (turned into δ once per strand, [`Tally::from_measures`]).
+    let e = x - chain.position;
+    let squared_length = e.dot(e);
+    let strain = (squared_length - node.segment_length * node.segment_length) * node.strain_scale;
+    if setup.collisions {
+        let touched = contact | previous_contact;
+        let free = active & !touched;
+        let pushed = active & touched;
+        measures.stretched = measures.stretched.max(T::select(free, strain, zero));
+        measures.compressed = measures.compressed.max(T::select(free, -strain, zero));
+        measures.contact_stretched = measures
+            .contact_stretched
+            .max(T::select(pushed, strain, zero));
+        measures.contact_compressed = measures
+            .contact_compressed
+            .max(T::select(pushed, -strain, zero));
+    } else {
+        // No collider, no contact: the contact extremes stay 0 in both forms.
+        measures.stretched = measures.stretched.max(T::select(active, strain, zero));
+        measures.compressed = measures.compressed.max(T::select(active, -strain, zero));
+    }
+    // Line 21: the frame, carried only when the shape constraints need it. The tangent from
+    // follow-the-leader holds unless a collider moved the node (or there was no projection).
+    let next = if setup.shape {
+        let known = tangent_known & !contact;
+        let t = if T::all(known) {
+            tangent
+        } else {
+            let length = squared_length.sqrt::<M>();
+            let exact = V3::select(
+                zero.lt(length),
+                e.scale(T::splat(1.0) / length),
+                chain.tangent,
+            );
+            V3::select(known, tangent, exact)
+        };
+        Chain {
+            position: x,
+            tangent: t,
+            normal: frame::transport(chain.tangent, chain.normal, t),
+        }
+    } else {
+        Chain {
+            position: x,
+            ..*chain
+        }
+    };
+    Advanced {
+        chain: next,
+        correction,
+        contact,
+    }
 }
 
-/// What a strand (or a block) tells the report about its segments and contacts.
+/// What a strand (or a block's lane) tells the report about its segments and contacts.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Tally {
-    /// Largest stretch of a segment without a pushed node.
+    /// Largest relative stretch `| |e| − l | / l` of a segment without a pushed node.
     pub stretch: Real,
-    /// Largest stretch of a segment with a pushed node.
+    /// Largest relative stretch of a segment with a pushed node.
     pub contact_stretch: Real,
     /// Deepest node left inside a collider.
     pub penetration: Real,
     /// Nodes pushed out.
     pub contacts: u32,
+    /// `Σ m Δx^push` per collider.
+    pub collider_push: [Vec3; MAX_COLLIDERS],
+}
+
+/// The relative stretch `δ` of a strain `s = δ + δ²/2`: `δ = 2s / (1 + √(1 + 2s))` (the form
+/// without cancellation for small `s`).
+fn relative_stretch<M: Math>(strain: Real) -> Real {
+    2.0 * strain / (1.0 + M::sqrt((1.0 + 2.0 * strain).max(0.0)))
 }
 
 impl Tally {
-    /// Folds the tally into `report` (maxima and counts only: the same whatever the order).
-    pub fn report(&self, report: &mut StepReport) {
+    /// One lane's measures as the report gives them. `δ(s)` grows with `s`, so the largest
+    /// `|δ|` is at the largest or the most negative strain.
+    #[must_use]
+    pub fn from_measures<M: Math>(m: &Measures<Real>) -> Self {
+        let stretch =
+            |up: Real, down: Real| relative_stretch::<M>(up).max(-relative_stretch::<M>(-down));
+        Tally {
+            stretch: stretch(m.stretched, m.compressed),
+            contact_stretch: stretch(m.contact_stretched, m.contact_compressed),
+            penetration: m.penetration,
+            contacts: m.contacts as u32,
+            collider_push: m.collider_push.map(Vec3::from),
+        }
+    }
+
+    /// Folds the tally into `report`: maxima and counts, and each collider's contact force
+    /// `−Σ m Δx^push / Δt²` (the hair's push on the collider, as the rod solver reports it),
+    /// added strand by strand in strand order.
+    pub fn report(&self, report: &mut StepReport, collisions: bool, inv_dt: Real) {
         report.max_stretch = report.max_stretch.max(self.stretch);
         report.max_contact_stretch = report.max_contact_stretch.max(self.contact_stretch);
         report.max_penetration = report.max_penetration.max(self.penetration);
         report.contacts += self.contacts;
+        if collisions {
+            let scale = -(inv_dt * inv_dt);
+            for (force, push) in report.collider_forces.iter_mut().zip(self.collider_push) {
+                *force += push * scale;
+            }
+        }
     }
 }
 
@@ -308,13 +446,13 @@ pub fn step<M: Math, const N: usize>(
     }
     let rest = &strand.rest;
     let state = &mut strand.state;
-    let mut chain = Chain::start::<M>(
+    let mut chain = Chain::start(
         &setup,
-        rest.dftl.root_frame,
-        state.position[0],
-        state.position[1],
+        rest.dftl.root_tangent.into(),
+        rest.dftl.root_normal.into(),
+        state.position[1].into(),
     );
-    let mut tally = Tally::default();
+    let mut measures = Measures::default();
     let mut previous_contact = false;
     for i in 2..n {
         let extra = accelerations.and_then(|a| a.get(i)).copied();
@@ -328,44 +466,31 @@ pub fn step<M: Math, const N: usize>(
             local_rest: rest.dftl.local_rest[i].into(),
             root_distance: rest.dftl.root_distance[i],
             segment_length: rest.segment_length[i - 1],
+            strain_scale: rest.dftl.strain_scale[i],
         };
-        // Lines 13–19: predict, shape, follow the leader.
-        let (mut x, correction) = project_node::<M, Real>(&setup, &node, &chain);
-        // Line 20: collisions, then what is left inside (the report's penetration).
-        let mut contact = false;
-        if setup.collisions {
-            for shape in ctx.colliders() {
-                let (pushed, inside) = collisions::push_out::<M, Real>(shape, x);
-                x = pushed;
-                contact |= inside;
-            }
-            for shape in ctx.colliders() {
-                tally.penetration = tally
-                    .penetration
-                    .max(collisions::depth::<M, Real>(shape, x));
-            }
-            tally.contacts += u32::from(contact);
-        }
-        // Line 21: frame update (and the segment's stretch, with or without contact).
-        let (next, stretch) = chain.advance::<M>(&setup, x, node.segment_length);
-        if contact || previous_contact {
-            tally.contact_stretch = tally.contact_stretch.max(stretch);
-        } else {
-            tally.stretch = tally.stretch.max(stretch);
-        }
+        // Lines 13–21: predict, shape, follow the leader, collisions, frame.
+        let next = advance::<M, Real>(
+            &setup,
+            ctx.colliders(),
+            &node,
+            &chain,
+            true,
+            previous_contact,
+            &mut measures,
+        );
         // Lines 24–26 for node i − 1, now that node i's correction is known.
         if i > 2 {
             let (x_new, v_new) = velocity::finish(
                 &setup,
                 chain.position,
                 state.position[i - 1].into(),
-                correction,
+                next.correction,
             );
             state.position[i - 1] = x_new.into();
             state.velocity[i - 1] = v_new.into();
         }
-        chain = next;
-        previous_contact = contact;
+        chain = next.chain;
+        previous_contact = next.contact;
     }
     // The last node: no correction (eq. 14 has no node n).
     let (x_new, v_new) = velocity::finish(
@@ -376,7 +501,7 @@ pub fn step<M: Math, const N: usize>(
     );
     state.position[n - 1] = x_new.into();
     state.velocity[n - 1] = v_new.into();
-    tally.report(report);
+    Tally::from_measures::<M>(&measures).report(report, setup.collisions, setup.inv_dt);
 }
 
 #[cfg(test)]
@@ -439,15 +564,36 @@ mod tests {
             &[],
         );
         let setup = Setup::new(&ctx);
-        let mut chain = Chain::start::<Libm>(&setup, s.rest.dftl.root_frame, points[0], points[1]);
+        let mut chain = Chain::start(
+            &setup,
+            s.rest.dftl.root_tangent.into(),
+            s.rest.dftl.root_normal.into(),
+            points[1].into(),
+        );
         for (i, point) in points.iter().enumerate().skip(2) {
             let target = Vec3::from(chain.position)
-                + math::rotate(chain.frame.into(), s.rest.dftl.local_rest[i]);
+                + Vec3::from(frame::rotate(
+                    chain.tangent,
+                    chain.normal,
+                    s.rest.dftl.local_rest[i].into(),
+                ));
             assert!((target - *point).length() < 1e-7, "node {i}");
-            let x = (*point).into();
-            chain = chain
-                .advance::<Libm>(&setup, x, s.rest.segment_length[i - 1])
-                .0;
+            let node = NodeInput {
+                position: (*point).into(),
+                velocity: V3::zero(),
+                extra: V3::zero(),
+                has_extra: false,
+                inverse_mass: s.rest.inverse_mass[i],
+                rest_position: s.rest.position[i].into(),
+                local_rest: s.rest.dftl.local_rest[i].into(),
+                root_distance: s.rest.dftl.root_distance[i],
+                segment_length: s.rest.segment_length[i - 1],
+                strain_scale: s.rest.dftl.strain_scale[i],
+            };
+            let mut measures = Measures::default();
+            chain =
+                advance::<Libm, Real>(&setup, &[], &node, &chain, true, false, &mut measures).chain;
+            assert!(measures.stretched < 1e-6 && measures.compressed < 1e-6);
         }
         assert_eq!(s.rest.dftl.root_distance[11], 1.0);
     }

@@ -1,21 +1,28 @@
 //! DFTL's rest data (Sánchez-Banderas 2015 Sec. 3.1 after Han & Harada 2012): the root frame
-//! `R̂_0` and the local rest vectors `r_i`, computed once in `Strand::from_polyline`.
+//! `R̂_0` (as its tangent and normal) and the local rest vectors `r_i`, computed once in
+//! `Strand::from_polyline`, plus the per-segment factor the step measures strain with.
 
-use crate::math::{self, Math, Quat, Real, Vec3};
+use crate::math::{self, Math, Real, Vec3};
 
 use super::frame;
 
 /// What DFTL's shape constraints need of a strand at rest (in the head's frame).
 #[derive(Clone, Debug, PartialEq)]
 pub struct DftlRest<const N: usize> {
-    /// `R̂_0`: the root frame, whose x-axis is the first rest segment's direction `t̂_0`.
-    pub root_frame: Quat,
-    /// `r_i = R̂_{i−1}⁻¹ (x̂_i − x̂_{i−1})`: node `i`'s rest offset in the frame of node `i − 1`
-    /// (entries 0 and 1 unused: those nodes are held by the head).
+    /// `t̂_0 = R̂_0 e_x`: the first rest segment's direction.
+    pub root_tangent: Vec3,
+    /// `n̂_0 = R̂_0 e_y`, `R̂_0` the minimal rotation from `e_x` to `t̂_0`.
+    pub root_normal: Vec3,
+    /// `r_i = R̂_{i−1}⁻¹ (x̂_i − x̂_{i−1})`: node `i`'s rest offset in the frame of node `i − 1`,
+    /// as components along `(t̂_{i−1}, n̂_{i−1}, t̂_{i−1} × n̂_{i−1})` (entries 0 and 1 unused:
+    /// those nodes are held by the head).
     pub local_rest: [Vec3; N],
     /// `d_i / L`: rest distance from the root along the strand over the strand's length, 0 at
     /// the root and 1 at the tip (for coefficients that fade with distance from the root).
     pub root_distance: [Real; N],
+    /// `1 / (2 l_{i−1}²)` for the segment ending at node `i` (0 for `i = 0`): the step measures
+    /// the strain `(|e|² − l²)/(2 l²)` without a square root or a division.
+    pub strain_scale: [Real; N],
 }
 
 impl<const N: usize> DftlRest<N> {
@@ -26,28 +33,40 @@ impl<const N: usize> DftlRest<N> {
     #[must_use]
     pub fn from_polyline<M: Math>(points: &[Vec3]) -> Self {
         let mut rest = DftlRest {
-            root_frame: Quat::IDENTITY,
+            root_tangent: Vec3::X,
+            root_normal: Vec3::Y,
             local_rest: [Vec3::ZERO; N],
             root_distance: [0.0; N],
+            strain_scale: [0.0; N],
         };
         let n = points.len().min(N);
         if n < 2 {
             return rest;
         }
         let first = points[1] - points[0];
-        let tangent = first * (1.0 / M::length(first));
-        rest.root_frame = frame::from_x_axis::<M>(tangent);
-        let mut frame_i = rest.root_frame;
-        let mut tangent_i = tangent;
-        let mut distance = M::length(first);
+        let first_length = M::length(first);
+        // As the step computes a tangent: the edge times the reciprocal of its length.
+        let mut tangent = first * (1.0 / first_length);
+        let root_frame = frame::from_x_axis::<M>(tangent);
+        rest.root_tangent = tangent;
+        rest.root_normal = math::rotate(root_frame, Vec3::Y);
+        rest.strain_scale[1] = 0.5 / (first_length * first_length);
+        let mut normal = rest.root_normal;
+        let mut distance = first_length;
         rest.root_distance[1] = distance;
         for i in 2..n {
             let edge = points[i] - points[i - 1];
             let length = M::length(edge);
-            rest.local_rest[i] = math::rotate(math::quat_conjugate(frame_i), edge);
-            let (next_frame, next_tangent) =
-                frame::transport::<M, Real>(frame_i.into(), tangent_i.into(), edge.into(), length);
-            (frame_i, tangent_i) = (next_frame.into(), next_tangent.into());
+            rest.local_rest[i] = Vec3::new(
+                edge.dot(tangent),
+                edge.dot(normal),
+                edge.dot(tangent.cross(normal)),
+            );
+            rest.strain_scale[i] = 0.5 / (length * length);
+            let next_tangent = edge * (1.0 / length);
+            normal =
+                frame::transport::<Real>(tangent.into(), normal.into(), next_tangent.into()).into();
+            tangent = next_tangent;
             distance += length;
             rest.root_distance[i] = distance;
         }
@@ -56,5 +75,37 @@ impl<const N: usize> DftlRest<N> {
             *d /= total;
         }
         rest
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dftl::lane::V3;
+    use crate::math::Libm;
+
+    #[test]
+    fn local_rest_vectors_rebuild_the_polyline() {
+        let points: [Vec3; 6] = core::array::from_fn(|i| {
+            let s = i as Real * 0.01;
+            Vec3::new(0.004 * (50.0 * s).sin(), s, 0.004 * (50.0 * s).cos())
+        });
+        let rest = DftlRest::<6>::from_polyline::<Libm>(&points);
+        let mut tangent: V3<Real> = rest.root_tangent.into();
+        let mut normal: V3<Real> = rest.root_normal.into();
+        assert!((Vec3::from(tangent).dot(normal.into())).abs() < 1e-7);
+        for i in 2..6 {
+            let edge: Vec3 = frame::rotate(tangent, normal, rest.local_rest[i].into()).into();
+            let expected = points[i] - points[i - 1];
+            assert!(
+                (edge - expected).length() < 1e-8,
+                "node {i}: {edge} vs {expected}"
+            );
+            let t = expected * (1.0 / expected.length());
+            normal = frame::transport(tangent, normal, t.into());
+            tangent = t.into();
+            let n: Vec3 = normal.into();
+            assert!(n.dot(t).abs() < 1e-6 && (n.length() - 1.0).abs() < 1e-6);
+        }
     }
 }

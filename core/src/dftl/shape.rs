@@ -3,7 +3,8 @@
 //! fractions are per step at the world's `dt` (`DftlParams::at_step`) and fade linearly with
 //! rest distance from the root.
 
-use super::lane::{Lane, Q, V3};
+use super::frame;
+use super::lane::{Lane, V3};
 use super::Setup;
 
 /// SB15 eq. (11): `Δx^gbl_i = s_g (p_i − x*_i)`, `p_i = T_head(x̂_i)` — the rest position
@@ -19,23 +20,20 @@ pub fn global_correction<T: Lane>(
     let c = &setup.coefficients;
     let s =
         T::splat(c.global_shape) * (T::splat(1.0) - T::splat(c.global_shape_fade) * root_distance);
-    let r = &setup.head_rotation;
-    // R x̂ + t, summed column by column as glam's `Mat3 * Vec3`.
-    let target = V3::splat(r.x_axis).scale(rest_position.x)
-        + V3::splat(r.y_axis).scale(rest_position.y)
-        + V3::splat(r.z_axis).scale(rest_position.z)
-        + V3::splat(setup.head_position);
+    let target = setup.head_rotate(rest_position) + V3::splat(setup.head_position);
     (target - x).scale(s)
 }
 
 /// SB15 eq. (12): `Δx^lcl_i = s_l (p^{i−1}_i − x*_i)`, `p^{i−1}_i = x*_{i−1} + R_{i−1} r_i` — the
-/// rest offset carried by the (already final) previous node's frame.
+/// rest offset carried by the (already final) previous node's frame `R_{i−1} = (t, n, t × n)`:
+/// a rotation of the rest vector, no square root.
 #[inline(always)]
 #[must_use]
 pub fn local_correction<T: Lane>(
     setup: &Setup,
     previous: V3<T>,
-    previous_frame: Q<T>,
+    previous_tangent: V3<T>,
+    previous_normal: V3<T>,
     local_rest: V3<T>,
     root_distance: T,
     x: V3<T>,
@@ -43,6 +41,6 @@ pub fn local_correction<T: Lane>(
     let c = &setup.coefficients;
     let s =
         T::splat(c.local_shape) * (T::splat(1.0) - T::splat(c.local_shape_fade) * root_distance);
-    let target = previous + previous_frame.rotate(local_rest);
+    let target = previous + frame::rotate(previous_tangent, previous_normal, local_rest);
     (target - x).scale(s)
 }
