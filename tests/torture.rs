@@ -545,6 +545,9 @@ fn nodes_starting_inside_the_head() {
         .known_failure("pushed out within steps, then rolled back every step from ~34")
         .run();
     }
+    // DFTL pushes the nodes out in the first step and takes their velocity from the move
+    // (eq. 14): up to 3 cm in 1 ms, so the speed bound is that push-out speed, 30 m/s
+    // (measured 19.4 m/s with eq. 14's local + inextensibility feedback).
     Case::new(
         "inside the head DFTL",
         dftl(0.001),
@@ -552,7 +555,7 @@ fn nodes_starting_inside_the_head() {
         1000,
     )
     .collider(head_sphere(), true)
-    .bounds(2.0, 15.0)
+    .bounds(2.0, 30.0)
     .settle(20)
     .run();
 }
@@ -898,13 +901,12 @@ fn a_strand_at_rest_for_ten_seconds_does_not_flicker() {
         println!("at rest rod ×{factor}: largest move per step {worst:e} m");
         assert!(worst <= 1e-7, "×{factor}: {worst:e} m");
     }
-    // The rod measures exactly 0 in every configuration. DFTL measures 2.2e-3 m per step in
-    // every configuration: its hanging strand does not come to rest (an open DFTL problem,
-    // reported; not asserted here).
+    // The rod measures exactly 0 in every configuration; DFTL 1.9e-9 m per step (rounding:
+    // eq. 14 feeds back the local shape and inextensibility corrections, not the global pull
+    // that kept a hanging strand moving 2.2 mm per step before).
     for (solver, mode, cap, worst) in results {
-        if solver == Solver::Rod {
-            assert!(worst <= 1e-7, "{solver:?} {mode:?} cap {cap}: {worst:e} m");
-        }
+        let bound = if solver == Solver::Rod { 1e-7 } else { 1e-8 };
+        assert!(worst <= bound, "{solver:?} {mode:?} cap {cap}: {worst:e} m");
     }
 }
 
