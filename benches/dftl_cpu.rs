@@ -10,6 +10,7 @@
 
 use std::time::Instant;
 
+use hairsim_benches::cpu_seconds;
 use hairsim_core::context::StepContext;
 use hairsim_core::dftl::{step_blocks, DftlBlock};
 use hairsim_core::{
@@ -35,21 +36,6 @@ impl Math for HostMath {
     fn atan2(y: Real, x: Real) -> Real {
         libm::atan2f(y, x)
     }
-}
-
-/// CPU seconds used by this process so far (user + system).
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the parenthesised command name; utime and stime are fields 14 and 15.
-    let rest = stat.rsplit(')').next().unwrap_or("");
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|f| f.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) / 100.0
 }
 
 fn strands<const N: usize>(count: usize) -> Vec<Strand<N>> {

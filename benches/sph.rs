@@ -17,26 +17,13 @@ use std::time::{Duration, Instant};
 
 use hairsim::scene::{HairSpec, Prepared, Scene};
 use hairsim::sim::{scene_inputs, Sim, StepInputs};
+use hairsim_benches::cpu_seconds;
 use hairsim_core::DefaultMath;
 
 /// Steps before timing (0.5 s of the scene at 1/60 s).
 const WARM_UP: u64 = 30;
 /// Steps timed.
 const STEPS: u64 = 20;
-
-/// CPU seconds used by this process so far (user + system).
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let rest = stat.rsplit(')').next().unwrap_or("");
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| {
-        fields
-            .get(i)
-            .and_then(|f| f.parse::<f64>().ok())
-            .unwrap_or(0.0)
-    };
-    (ticks(11) + ticks(12)) / 100.0
-}
 
 /// A Table 1 size: name, strands, nodes per strand (vertices = strands × nodes; the paper's
 /// count in the comment where it is not a multiple).
