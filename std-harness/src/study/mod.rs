@@ -284,7 +284,7 @@ impl Config {
             }
             for s in &mut p.strands {
                 let k = resampled_nodes(s.points.len(), self.node_factor);
-                s.points = resample(&s.points, k);
+                s.points = crate::hairfile::resample_polyline(&s.points, k);
             }
         }
         Ok(p)
@@ -312,16 +312,6 @@ fn ms(dt: Real) -> String {
 pub fn resampled_nodes(n: usize, factor: Real) -> usize {
     let segments = ((n.saturating_sub(1)) as f64 * f64::from(factor)).round() as usize;
     (segments.max(2) + 1).min(MAX_NODES)
-}
-
-/// `k` points evenly spaced by arc length along the polyline `points` (root and tip kept).
-#[must_use]
-pub fn resample(points: &[Vec3], k: usize) -> Vec<Vec3> {
-    let arc = arc_lengths(points);
-    let total = arc.last().copied().unwrap_or(0.0);
-    (0..k)
-        .map(|j| point_at(points, &arc, total * j as f64 / (k - 1).max(1) as f64))
-        .collect()
 }
 
 /// Cumulative length along a polyline, from 0 at the first point.
@@ -655,7 +645,7 @@ mod tests {
             Vec3::new(1.0, 0.0, 0.0),
             Vec3::new(1.0, 3.0, 0.0),
         ];
-        let r = resample(&points, 5);
+        let r = crate::hairfile::resample_polyline(&points, 5);
         assert_eq!(r.len(), 5);
         assert_eq!(r[0], points[0]);
         assert!(r[4].distance(points[2]) < 1e-6);
