@@ -443,7 +443,9 @@ impl Plan {
                 .into_iter()
                 .map(|math| Config { math, ..from })
                 .collect(),
-            Knob::Damping => pick(q, &[0.0, 0.3, 0.6, 0.9, 1.0], &[0.0, 0.9])
+            // From the least `s_d` the validator accepts with the local shape constraint on
+            // (`hairsim_core::params::MIN_SHAPE_DAMPING`; below it the strand flutters).
+            Knob::Damping => pick(q, &[0.5, 0.6, 0.75, 0.9, 1.0], &[0.5, 0.9])
                 .into_iter()
                 .map(|damping| Config { damping, ..from })
                 .collect(),
