@@ -156,3 +156,174 @@ pub fn apply_slips(grabs: &mut [Grab], report: &crate::report::StepReport) {
         }
     }
 }
+
+/// Slack allowed on a grab's reach: the projection's stretch bound (issue 4: 0.1 %).
+pub const REACH_SLACK: Real = 1.0e-3;
+
+/// Before a step: a held grab whose target no inextensible strand can reach slips at once,
+/// and its bit is set in `report.grabs_slipped`.
+///
+/// Holding it would take an unbounded force: the projection, asked for positions that do
+/// not exist (prescribed nodes carry no rows, DESIGN.md), stretches and kinks the strand
+/// before the force limit lets go a step or two later, and the strand then whips from that
+/// state (measured in `tests/torture.rs`: chatter 3.5 rad). A target is out of reach when
+/// it is farther from the strand's head-held node 1 (where the head puts it this step), or
+/// from another held grab's target on the same strand, than the rest arc length between the
+/// two nodes, with [`REACH_SLACK`]. `strands[k]` is strand `first_strand + k`.
+pub fn slip_unreachable<const N: usize>(
+    ctx: &crate::context::StepContext,
+    grabs: &mut [Grab],
+    strands: &[crate::strand::Strand<N>],
+    first_strand: u32,
+    report: &mut crate::report::StepReport,
+) {
+    if !ctx.has(crate::effects::Effect::Grabs) {
+        return;
+    }
+    let count = grabs.len().min(MAX_GRABS);
+    let mut out_of_reach = 0u8;
+    for a in 0..count {
+        let Some((rest, root, node_a, target_a)) = held(grabs, a, strands, first_strand) else {
+            continue;
+        };
+        let anchor = ctx.head.transform_point(root);
+        if !within_reach(rest, 1, node_a, anchor, target_a) {
+            out_of_reach |= 1 << a;
+        }
+        for b in a + 1..count {
+            let Some((rest_b, _, node_b, target_b)) = held(grabs, b, strands, first_strand) else {
+                continue;
+            };
+            // Two grabs on the same strand share its rest data.
+            if core::ptr::eq(rest, rest_b)
+                && !within_reach(
+                    rest,
+                    node_a.min(node_b),
+                    node_a.max(node_b),
+                    target_a,
+                    target_b,
+                )
+            {
+                out_of_reach |= (1 << a) | (1 << b);
+            }
+        }
+    }
+    for (g, grab) in grabs.iter_mut().enumerate().take(count) {
+        if out_of_reach & (1 << g) != 0 {
+            grab.status = GrabStatus::Slipped;
+        }
+    }
+    report.grabs_slipped |= out_of_reach;
+}
+
+/// Grab `g` if it holds a node of one of `strands`: the strand's rest data, its rest node 1,
+/// the grabbed node and the target.
+fn held<'a, const N: usize>(
+    grabs: &[Grab],
+    g: usize,
+    strands: &'a [crate::strand::Strand<N>],
+    first_strand: u32,
+) -> Option<(&'a crate::strand::RestStrand<N>, Vec3, usize, Vec3)> {
+    let grab = grabs.get(g)?;
+    let strand = strands.get(grab.strand.checked_sub(first_strand)? as usize)?;
+    let node = grab.node as usize;
+    let usable = grab.status == GrabStatus::Held
+        && (2..strand.nodes()).contains(&node)
+        && crate::math::is_finite(grab.target);
+    let root = *strand.rest.position.get(1)?;
+    usable.then_some((&strand.rest, root, node, grab.target))
+}
+
+/// Whether points `a` and `b`, held at nodes `from < to`, are no farther apart than the rest
+/// arc length between those nodes (with [`REACH_SLACK`]).
+fn within_reach<const N: usize>(
+    rest: &crate::strand::RestStrand<N>,
+    from: usize,
+    to: usize,
+    a: Vec3,
+    b: Vec3,
+) -> bool {
+    let arc: Real = rest
+        .segment_length
+        .get(from..to)
+        .map_or(0.0, |lengths| lengths.iter().sum());
+    let reach = arc * (1.0 + REACH_SLACK);
+    // Squared on both sides: no square root.
+    (b - a).length_squared() <= reach * reach
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::effects::{Effect, Effects};
+    use crate::head::Pose;
+    use crate::math::Libm;
+    use crate::params::{Params, Solver};
+    use crate::strand::{Material, Strand};
+    use crate::world::{StepInput, World};
+
+    /// Two straight 5 cm strands (6 nodes, 1 cm apart) along x, the rod with grabs.
+    fn world() -> World<2, 8, Libm> {
+        let mut w = World::with_params(Params {
+            solver: Solver::Rod,
+            effects: Effects::NONE
+                .with(Effect::Inextensibility)
+                .with(Effect::Grabs),
+            ..Params::DEFAULT
+        })
+        .unwrap();
+        for z in [0.0, 0.1] {
+            let points: [Vec3; 6] = core::array::from_fn(|i| Vec3::new(0.01 * i as Real, 0.0, z));
+            w.add_strand(Strand::from_polyline(&points, &Material::HUMAN_HAIR).unwrap())
+                .unwrap();
+        }
+        w
+    }
+
+    fn step(w: &mut World<2, 8, Libm>) -> crate::report::StepReport {
+        w.step(&StepInput {
+            head: Pose::IDENTITY,
+            accelerations: None,
+        })
+    }
+
+    #[test]
+    fn a_target_within_reach_holds() {
+        let mut w = world();
+        // Node 5 is 4 cm of hair from node 1: a target 3.9 cm from node 1, off the axis.
+        w.add_grab(Grab::new(0, 5, Vec3::new(0.01, 0.039, 0.0), 1.0))
+            .unwrap();
+        let report = step(&mut w);
+        assert_eq!(report.grabs_slipped, 0);
+        assert_eq!(w.grabs()[0].status, GrabStatus::Held);
+    }
+
+    #[test]
+    fn a_target_beyond_the_strand_slips_before_the_step() {
+        let mut w = world();
+        // 4.1 cm from node 1: out of reach by 2.5 %, whatever the force limit.
+        w.add_grab(Grab::new(0, 5, Vec3::new(0.01, 0.041, 0.0), 1.0e9))
+            .unwrap();
+        let report = step(&mut w);
+        assert_eq!(report.grabs_slipped, 1);
+        assert_eq!(w.grabs()[0].status, GrabStatus::Slipped);
+        // The strand was never stretched towards it.
+        assert!(report.max_stretch < 1.0e-3, "{}", report.max_stretch);
+    }
+
+    #[test]
+    fn two_grabs_farther_apart_than_the_hair_between_them_both_slip() {
+        let mut w = world();
+        // Nodes 2 and 5 of strand 0: 3 cm of hair; targets 3.2 cm apart, each within reach
+        // of node 1. A grab on the other strand, within reach, holds.
+        w.add_grab(Grab::new(0, 2, Vec3::new(0.01, -0.005, 0.0), 1.0e9))
+            .unwrap();
+        w.add_grab(Grab::new(0, 5, Vec3::new(0.01, 0.027, 0.0), 1.0e9))
+            .unwrap();
+        w.add_grab(Grab::new(1, 5, Vec3::new(0.05, 0.0, 0.1), 1.0e9))
+            .unwrap();
+        let report = step(&mut w);
+        assert_eq!(report.grabs_slipped, 0b011);
+        assert_eq!(w.grabs()[2].status, GrabStatus::Held);
+    }
+}

@@ -253,6 +253,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             &self.colliders,
         )
         .at_time(time);
+        crate::grab::slip_unreachable(&ctx, &mut self.grabs, &self.strands, 0, &mut report);
         step_strands::<M, N>(
             &ctx,
             &mut self.strands,

@@ -206,6 +206,8 @@ impl<const N: usize, M: Math> Sim<N, M> {
             }
             _ => None,
         };
+        // A grab pulled out of the strand's reach lets go before the step (as `World::step`).
+        hairsim_core::grab::slip_unreachable(&ctx, &mut self.grabs, &self.strands, 0, &mut report);
         let block = self.block;
         let grabs = self.grabs.as_slice();
         let step_block = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
