@@ -119,6 +119,16 @@ pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u
     dropped
 }
 
+/// Undoes [`eliminate_contacts`] on the segment rows (`rhs = C`, `projected = ∇C`), so that
+/// it can run again on a changed set of collision rows.
+pub fn undo_elimination<const N: usize>(rows: &mut Rows<N>) {
+    let count = rows.count.min(N);
+    for row in rows.rows.iter_mut().take(count) {
+        row.rhs = row.value;
+        row.projected = row.gradient;
+    }
+}
+
 /// Fills `contacts.inverse_gram` and `kept`; returns the rows dropped (dependent or empty).
 fn gram_inverse(contacts: &mut NodeContacts) -> u32 {
     let [g0, g1] = contacts.gradient;
