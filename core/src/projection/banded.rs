@@ -84,11 +84,17 @@ pub fn assemble(rows: &[Row], first: &[u16], inverse_mass: &[Real], band: &mut [
 /// projected onto the contacts' tangent space (`Row::projected`) and `rhs −= ∇C·d`; the node
 /// later moves by `−d − w (I − P) Σ_s ∇_sC δλ_s`. A second collision row whose gradient
 /// nearly depends on the first (a pivot below [`PIVOT_RATIO`]) is dropped. Returns how many
-/// collision rows were dropped. O(contacts).
+/// collision rows were dropped. O(contacts): only the nodes of `rows.contact_nodes`.
 pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u32 {
     let mut dropped = 0;
-    for i in 0..nodes.min(N) {
-        let mut contacts = rows.contacts[i];
+    for k in 0..rows.contact_count.min(N) {
+        let i = usize::from(rows.contact_nodes[k]);
+        if i >= nodes {
+            continue;
+        }
+        let Some(&(mut contacts)) = rows.contacts.get(i) else {
+            continue;
+        };
         if contacts.count == 0 {
             rows.contacts[i].kept = 0;
             continue;

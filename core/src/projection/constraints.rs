@@ -214,8 +214,13 @@ pub struct Rows<const N: usize> {
     pub count: usize,
     /// Row index of segment `j`, or [`NO_ROW`].
     pub segment_row: [u16; N],
-    /// Each node's collision rows.
+    /// Each node's collision rows (all empty, `kept = 0`, but those of `contact_nodes`).
     pub contacts: [NodeContacts; N],
+    /// The nodes with collision rows at this iterate, in increasing order (`contact_count`
+    /// in use): the collision work of the solve visits these only.
+    pub contact_nodes: [u16; N],
+    /// Entries of `contact_nodes` in use.
+    pub contact_count: usize,
     /// `max_j |C_j| / (ê^j·ê^j)` over segment rows and `depth / |ê^{i−1}|` over nodes inside a
     /// collider (with or without a row): the relative residual at this iterate.
     pub residual: Real,
@@ -238,6 +243,8 @@ impl<const N: usize> Default for Rows<N> {
             count: 0,
             segment_row: [NO_ROW; N],
             contacts: [NodeContacts::default(); N],
+            contact_nodes: [0; N],
+            contact_count: 0,
             residual: 0.0,
             converged: true,
             max_depth: 0.0,
@@ -252,6 +259,12 @@ impl<const N: usize> Rows<N> {
     #[must_use]
     pub fn rows(&self) -> &[Row] {
         self.rows.get(..self.count).unwrap_or(&[])
+    }
+
+    /// The nodes with collision rows at this iterate, in increasing order.
+    #[must_use]
+    pub fn contact_nodes(&self) -> &[u16] {
+        self.contact_nodes.get(..self.contact_count).unwrap_or(&[])
     }
 
     /// The envelope starts of the rows in use.
@@ -446,7 +459,28 @@ fn near_surface<M: Math>(shape: &Shape, p: Vec3, margin: Real) -> Option<(Vec3, 
     }
 }
 
-/// The collision rows of every free node at this iterate (see [`evaluate`]).
+/// Whether `p` is surely further than `margin` outside `shape`: the squared-distance test of
+/// [`near_surface`] alone, no square root.
+#[inline(always)]
+fn beyond(shape: &Shape, p: Vec3, margin: Real) -> bool {
+    match *shape {
+        Shape::Sphere { centre, radius } => {
+            let d = p - centre;
+            let reach = radius + margin;
+            d.dot(d) >= reach * reach
+        }
+        Shape::Capsule { a, b, radius } => {
+            let d = p - crate::collide::closest_on_segment(p, a, b);
+            let reach = radius + margin;
+            d.dot(d) >= reach * reach
+        }
+        Shape::Plane { point, normal } => (p - point).dot(normal) >= margin,
+    }
+}
+
+/// The collision rows of every free node at this iterate (see [`evaluate`]). One collider
+/// at a time over the nodes, so that the common case — a node far from it — is a
+/// squared-distance test in a tight loop; each node still gets its rows in collider order.
 fn detect_contacts<M: Math, const N: usize>(
     strand: &Strand<N>,
     nodes: &Nodes<N>,
@@ -459,24 +493,31 @@ fn detect_contacts<M: Math, const N: usize>(
     let x = &strand.state.position;
     let rest_length = &strand.rest.segment_length;
     let count = nodes.count.min(N);
+    // The previous iterate's rows: every other node's are empty already.
+    for k in 0..rows.contact_count.min(N) {
+        if let Some(contacts) = rows.contacts.get_mut(usize::from(rows.contact_nodes[k])) {
+            (contacts.count, contacts.tentative, contacts.kept) = (0, 0, 0);
+        }
+    }
+    rows.contact_count = 0;
     let margin_fraction = if layout.contact_margin && !layout.residual_only {
         CONTACT_MARGIN
     } else {
         0.0
     };
-    for i in 0..count {
-        rows.contacts[i].count = 0;
-        rows.contacts[i].tentative = 0;
-        if colliders.is_empty() || !nodes.is_free(i) {
-            continue;
-        }
-        // Node i ≥ 2 when free, so the segment before it exists.
-        let scale = rest_length[i.saturating_sub(1)];
-        let margin = margin_fraction * scale;
-        for &(c, ref shape) in colliders {
-            let bit = 1u8 << (c % 8);
+    let mut ordered = true;
+    for &(c, ref shape) in colliders {
+        let bit = 1u8 << (c % 8);
+        // Nodes 0 and 1 are prescribed (root coupling): never a row.
+        for i in 2..count {
+            let free = nodes.is_free(i);
             // Test the bit first: most nodes never touch anything.
-            let sticky = memory.touched[i] & bit != 0
+            let remembered = memory.touched[i] & bit != 0;
+            let margin = margin_fraction * rest_length[i - 1];
+            if !free || (!remembered && beyond(shape, x[i], margin)) {
+                continue;
+            }
+            let sticky = remembered
                 && memory.multipliers[i]
                     .get(usize::from(c))
                     .is_some_and(|&lambda| lambda < 0.0);
@@ -490,6 +531,7 @@ fn detect_contacts<M: Math, const N: usize>(
             let Some((normal, depth)) = found else {
                 continue;
             };
+            let scale = rest_length[i - 1];
             if depth > 0.0 {
                 rows.residual = rows.residual.max(depth / scale);
                 rows.max_depth = rows.max_depth.max(depth);
@@ -505,16 +547,37 @@ fn detect_contacts<M: Math, const N: usize>(
             }
             let tentative = !sticky && depth <= 0.0;
             let (value, gradient) = contact(shape, normal, depth);
-            let room = usize::from(rows.contacts[i].count) < layout.contact_slots
-                || (!tentative && rows.contacts[i].tentative != 0);
-            if room && rows.contacts[i].push(c, value, gradient, tentative) {
+            let contacts = &mut rows.contacts[i];
+            let first = contacts.count == 0;
+            let room = usize::from(contacts.count) < layout.contact_slots
+                || (!tentative && contacts.tentative != 0);
+            if room && contacts.push(c, value, gradient, tentative) {
                 if tentative {
                     rows.tentative = true;
                 } else {
                     memory.touched[i] |= bit;
                 }
+                if first {
+                    let last = rows.contact_count.checked_sub(1);
+                    ordered &= last.is_none_or(|k| usize::from(rows.contact_nodes[k]) < i);
+                    if let Some(slot) = rows.contact_nodes.get_mut(rows.contact_count) {
+                        *slot = i as u16;
+                        rows.contact_count += 1;
+                    }
+                }
             } else if !tentative {
                 rows.truncated = true;
+            }
+        }
+    }
+    if !ordered {
+        // A later collider touched an earlier node: list them in node order again (the
+        // solve's sums must not depend on the colliders' order).
+        rows.contact_count = 0;
+        for i in 2..count {
+            if rows.contacts[i].count > 0 {
+                rows.contact_nodes[rows.contact_count] = i as u16;
+                rows.contact_count += 1;
             }
         }
     }

@@ -590,10 +590,17 @@ fn solve_and_move<M: Math, const N: usize>(
         }
     }
     // Collider forces: only where a node kept a contact row this iteration.
-    let contact_nodes = if any_contact { n } else { 0 };
-    for i in 0..contact_nodes {
-        let contacts = work.rows.contacts[i];
-        if contacts.kept == 0 {
+    let contact_nodes = if any_contact {
+        work.rows.contact_count.min(N)
+    } else {
+        0
+    };
+    for k in 0..contact_nodes {
+        let i = usize::from(work.rows.contact_nodes[k]);
+        let Some(&contacts) = work.rows.contacts.get(i) else {
+            continue;
+        };
+        if contacts.kept == 0 || i >= n {
             continue;
         }
         let segment_pull = segment_pull_on_node(&work.rows, multipliers, i);
@@ -634,9 +641,12 @@ fn prune_tentative<const N: usize>(
 ) -> bool {
     let mut removed = false;
     let mut left = false;
-    for (i, &w) in inverse_mass.iter().enumerate().take(n) {
-        let contacts = rows.contacts[i];
-        if contacts.tentative == 0 {
+    for k in 0..rows.contact_count.min(N) {
+        let i = usize::from(rows.contact_nodes[k]);
+        let (Some(&contacts), Some(&w)) = (rows.contacts.get(i), inverse_mass.get(i)) else {
+            continue;
+        };
+        if contacts.tentative == 0 || i >= n {
             continue;
         }
         let mut pulling = contacts.tentative;
