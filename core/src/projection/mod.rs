@@ -44,7 +44,7 @@ use crate::report::{Flags, Stage, StepReport};
 use crate::strand::Strand;
 
 use banded::BandRow;
-use constraints::{ContactMemory, Layout, Nodes, RowKind, Rows, MAX_NODE_CONTACTS};
+use constraints::{ContactMemory, Layout, Nodes, Rows, MAX_NODE_CONTACTS};
 
 /// What one projection did, besides what it adds to the report.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -533,43 +533,41 @@ fn solve_and_move<M: Math, const N: usize>(
     // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
     // the next ones converged; a radius of one strand length cut that short and broke the
     // iteration. Hence ten strand lengths.
-    // One pass over the rows (in segment order, so each node gets segment i − 1's share
-    // before segment i's, as a per-node gather would), then the contacts' share.
-    let step = &mut work.step;
-    for dx in step.iter_mut().take(n) {
-        *dx = Vec3::ZERO;
-    }
-    let inverse_mass = &work.nodes.inverse_mass;
-    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
-        if row.kind == RowKind::Padding {
-            continue;
-        }
-        for (&node, &projected) in row.nodes.iter().zip(row.projected.iter()) {
-            let i = usize::from(node);
-            if let (Some(dx), Some(&w)) = (step.get_mut(i), inverse_mass.get(i)) {
-                if w > 0.0 {
-                    *dx -= projected * (w * lambda);
+    // Gathered per node from its two segments (segment i − 1 first, as the rows are in
+    // segment order) and its contacts, with the longest move in the same pass. A node
+    // without collision rows has `kept = 0` (see `Rows::contacts`).
+    let mut any_contact = false;
+    let mut longest2: Real = 0.0;
+    let segment_row = &work.rows.segment_row;
+    let nodes = work
+        .step
+        .iter_mut()
+        .zip(work.nodes.inverse_mass.iter())
+        .zip(work.rows.contacts.iter())
+        .enumerate()
+        .take(n);
+    for (i, ((dx, &w), contacts)) in nodes {
+        let mut delta = Vec3::ZERO;
+        if w > 0.0 {
+            for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+                let r = segment_row
+                    .get(segment)
+                    .map_or(usize::MAX, |&r| usize::from(r));
+                if let (Some(row), Some(&lambda)) = (rows.get(r), multipliers.get(r)) {
+                    delta -= row.projected[block] * (w * lambda);
                 }
             }
         }
-    }
-    let mut any_contact = false;
-    for &node in work.rows.contact_nodes() {
-        let i = usize::from(node);
-        if let (Some(dx), Some(contacts)) = (step.get_mut(i), work.rows.contacts.get(i)) {
-            if contacts.kept > 0 && i < n {
-                *dx -= contacts.displacement;
-                any_contact = true;
-            }
+        if contacts.kept > 0 {
+            delta -= contacts.displacement;
+            any_contact = true;
         }
-    }
-    let mut longest2: Real = 0.0;
-    for dx in step.iter().take(n) {
-        let d2 = dx.dot(*dx);
+        let d2 = delta.dot(delta);
         // Not `max`, which would drop a NaN.
         if d2.is_nan() || d2 > longest2 {
             longest2 = d2;
         }
+        *dx = delta;
     }
     let step = &work.step;
     if !longest2.is_finite() {
