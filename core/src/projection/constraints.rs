@@ -6,7 +6,8 @@
 //! * Collision of node `i` with a sphere or capsule: `C = |x_i − c|² − r²`, `∇C = 2(x_i − c)ᵀ`
 //!   (`c` the centre, or the closest point of the capsule's axis; the row uses the secant
 //!   slope `(|x_i − c| + r) n`, equal to it on the surface — see [`contact`]); with a plane:
-//!   `C = (x_i − p)·n`, `∇C = nᵀ`. Only for nodes found inside, re-detected at every iterate.
+//!   `C = (x_i − p)·n`, `∇C = nᵀ`. Only for nodes found inside, re-detected at every iterate
+//!   (in converge mode also tentative rows for nodes just outside, see [`evaluate`]).
 //! * Root coupling and grabs have no rows: their nodes are prescribed (`w = 0`). A row on a
 //!   node of infinite mass is a zero row and makes the matrix singular, so prescribed nodes
 //!   never carry a collision row, and a segment between two prescribed nodes has no row.
