@@ -84,11 +84,17 @@ pub fn assemble(rows: &[Row], first: &[u16], inverse_mass: &[Real], band: &mut [
 /// projected onto the contacts' tangent space (`Row::projected`) and `rhs −= ∇C·d`; the node
 /// later moves by `−d − w (I − P) Σ_s ∇_sC δλ_s`. A second collision row whose gradient
 /// nearly depends on the first (a pivot below [`PIVOT_RATIO`]) is dropped. Returns how many
-/// collision rows were dropped. O(contacts).
+/// collision rows were dropped. O(contacts): only the nodes of `rows.contact_nodes`.
 pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u32 {
     let mut dropped = 0;
-    for i in 0..nodes.min(N) {
-        let mut contacts = rows.contacts[i];
+    for k in 0..rows.contact_count.min(N) {
+        let i = usize::from(rows.contact_nodes[k]);
+        if i >= nodes {
+            continue;
+        }
+        let Some(&(mut contacts)) = rows.contacts.get(i) else {
+            continue;
+        };
         if contacts.count == 0 {
             rows.contacts[i].kept = 0;
             continue;
@@ -96,9 +102,16 @@ pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u
         dropped += gram_inverse(&mut contacts);
         let [c0, c1] = contacts.value;
         let [inv00, inv01, inv11] = contacts.inverse_gram;
-        let (a0, a1) = (inv00 * c0 + inv01 * c1, inv01 * c0 + inv11 * c1);
         let [g0, g1] = contacts.gradient;
-        contacts.displacement = g0 * a0 + g1 * a1;
+        // One kept row (nearly every contact): `P v = g (g·v)/(g·g)`, the two-row formulas
+        // without their zero terms.
+        let single = contacts.kept <= 1;
+        contacts.displacement = if single {
+            g0 * (inv00 * c0)
+        } else {
+            let (a0, a1) = (inv00 * c0 + inv01 * c1, inv01 * c0 + inv11 * c1);
+            g0 * a0 + g1 * a1
+        };
         rows.contacts[i] = contacts;
         // The segments through node i: i − 1 (node i is its second) and i (its first).
         let through = [(i.wrapping_sub(1), 1), (i, 0)];
@@ -112,11 +125,26 @@ pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u
             if let Some(row) = rows.rows.get_mut(usize::from(r)) {
                 let g = row.gradient[block];
                 row.rhs -= g.dot(contacts.displacement);
-                row.projected[block] = g - project_onto_normals(&contacts, g);
+                let along = if single {
+                    g0 * (inv00 * g0.dot(g))
+                } else {
+                    project_onto_normals(&contacts, g)
+                };
+                row.projected[block] = g - along;
             }
         }
     }
     dropped
+}
+
+/// Undoes [`eliminate_contacts`] on the segment rows (`rhs = C`, `projected = ∇C`), so that
+/// it can run again on a changed set of collision rows.
+pub fn undo_elimination<const N: usize>(rows: &mut Rows<N>) {
+    let count = rows.count.min(N);
+    for row in rows.rows.iter_mut().take(count) {
+        row.rhs = row.value;
+        row.projected = row.gradient;
+    }
 }
 
 /// Fills `contacts.inverse_gram` and `kept`; returns the rows dropped (dependent or empty).
@@ -175,6 +203,18 @@ pub fn contact_multipliers(contacts: &NodeContacts, inverse_mass: Real, pull: Ve
     [inv00 * b0 + inv01 * b1, inv01 * b0 + inv11 * b1]
 }
 
+/// `1/d` for a pivot kept (`d > 0`), 0 for a dropped one: the one division per pivot, shared
+/// by the column of `L` below it and its unknown (VDIV is 14 cycles on a Cortex-M4F, a
+/// multiplication one).
+#[inline(always)]
+fn reciprocal(d: Real) -> Real {
+    if d > 0.0 {
+        1.0 / d
+    } else {
+        0.0
+    }
+}
+
 /// Factors `band` in place into `L D Lᵀ` (unit lower `L`). Returns how many rows were dropped
 /// at a singular or non-finite pivot. O(rows · w²).
 pub fn factor(band: &mut [BandRow], first: &[u16]) -> u32 {
@@ -188,8 +228,7 @@ pub fn factor(band: &mut [BandRow], first: &[u16]) -> u32 {
             for p in inner..j {
                 s -= band[r][r - p] * band[p][0] * band[j][j - p];
             }
-            let d = band[j][0];
-            band[r][r - j] = if d > 0.0 { s / d } else { 0.0 };
+            band[r][r - j] = s * reciprocal(band[j][0]);
         }
         // D_r = A_rr − Σ_p L_rp² D_p.
         let diagonal = band[r][0];
@@ -221,8 +260,7 @@ pub fn solve(band: &[BandRow], first: &[u16], rhs: &mut [Real]) {
     }
     // Diagonal: D u = z.
     for r in 0..count {
-        let d = band[r][0];
-        rhs[r] = if d > 0.0 { rhs[r] / d } else { 0.0 };
+        rhs[r] *= reciprocal(band[r][0]);
     }
     // Backward: Lᵀ y = u, a column of Lᵀ at a time from the last row up.
     for r in (0..count).rev() {
@@ -254,8 +292,8 @@ pub fn solve_chain(
 ) -> u32 {
     let count = rows.len().min(band.len()).min(multipliers.len());
     let mut dropped = 0;
-    // D and z of the previous row (root → tip).
-    let (mut d_above, mut z_above) = (0.0, 0.0);
+    // D, 1/D and z of the previous row (root → tip).
+    let (mut d_above, mut inverse_above, mut z_above) = (0.0, 0.0, 0.0);
     for r in 0..count {
         let row = &rows[r];
         let coupled = r > 0 && first.get(r).is_some_and(|&f| usize::from(f) < r);
@@ -274,7 +312,7 @@ pub fn solve_chain(
         let mut d = diagonal;
         let mut lower = 0.0;
         if coupled {
-            lower = if d_above > 0.0 { below / d_above } else { 0.0 };
+            lower = below * inverse_above;
             d -= lower * lower * d_above;
             z -= lower * z_above;
         }
@@ -283,10 +321,11 @@ pub fn solve_chain(
             d = 0.0;
             dropped += 1;
         }
+        let inverse = reciprocal(d);
         band[r][0] = d;
-        band[r][1] = if coupled { lower } else { 0.0 };
-        multipliers[r] = if d > 0.0 { z / d } else { 0.0 };
-        (d_above, z_above) = (d, z);
+        band[r][1] = lower;
+        multipliers[r] = z * inverse;
+        (d_above, inverse_above, z_above) = (d, inverse, z);
     }
     // Backward: Lᵀ y = u.
     for r in (1..count).rev() {

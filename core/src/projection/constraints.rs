@@ -6,7 +6,8 @@
 //! * Collision of node `i` with a sphere or capsule: `C = |x_i − c|² − r²`, `∇C = 2(x_i − c)ᵀ`
 //!   (`c` the centre, or the closest point of the capsule's axis; the row uses the secant
 //!   slope `(|x_i − c| + r) n`, equal to it on the surface — see [`contact`]); with a plane:
-//!   `C = (x_i − p)·n`, `∇C = nᵀ`. Only for nodes found inside, re-detected at every iterate.
+//!   `C = (x_i − p)·n`, `∇C = nᵀ`. Only for nodes found inside, re-detected at every iterate
+//!   (in converge mode also tentative rows for nodes just outside, see [`evaluate`]).
 //! * Root coupling and grabs have no rows: their nodes are prescribed (`w = 0`). A row on a
 //!   node of infinite mass is a zero row and makes the matrix singular, so prescribed nodes
 //!   never carry a collision row, and a segment between two prescribed nodes has no row.
@@ -114,11 +115,20 @@ pub struct NodeContacts {
     pub inverse_gram: [Real; 3],
     /// `d = G (GᵀG)⁻¹ C`: minus the smallest move that meets the linearised contacts.
     pub displacement: Vec3,
+    /// Bit `k`: row `k` is *tentative* — its node is outside the collider, within
+    /// [`CONTACT_MARGIN`] of it (see [`evaluate`]); it stays only if its multiplier pushes.
+    pub tentative: u8,
 }
 
 impl NodeContacts {
-    fn push(&mut self, collider: u8, value: Real, gradient: Vec3) -> bool {
-        let k = usize::from(self.count);
+    fn push(&mut self, collider: u8, value: Real, gradient: Vec3, tentative: bool) -> bool {
+        let mut k = usize::from(self.count);
+        if k >= MAX_NODE_CONTACTS && !tentative && self.tentative != 0 {
+            // A contact found inside takes the place of a tentative one.
+            k = self.tentative.trailing_zeros() as usize;
+            self.tentative &= !(1 << k);
+            self.count -= 1;
+        }
         match (
             self.collider.get_mut(k),
             self.value.get_mut(k),
@@ -127,10 +137,29 @@ impl NodeContacts {
             (Some(c), Some(v), Some(g)) => {
                 (*c, *v, *g) = (collider, value, gradient);
                 self.count += 1;
+                if tentative {
+                    self.tentative |= 1 << k;
+                }
                 true
             }
             _ => false,
         }
+    }
+}
+
+impl NodeContacts {
+    /// Removes the rows whose bit is set in `mask` (those after them move up): tentative
+    /// rows whose multiplier turned out to pull.
+    pub fn remove(&mut self, mask: u8) {
+        let mut kept = NodeContacts::default();
+        let count = usize::from(self.count).min(MAX_NODE_CONTACTS);
+        for k in 0..count {
+            if mask & (1 << k) == 0 {
+                let tentative = self.tentative & (1 << k) != 0;
+                kept.push(self.collider[k], self.value[k], self.gradient[k], tentative);
+            }
+        }
+        *self = kept;
     }
 }
 
@@ -165,6 +194,9 @@ pub struct Layout {
     /// Fixed cost: a row for every segment that may carry one (padding where it cannot) and
     /// the full band for every row, so the work does not depend on the state.
     pub fixed_cost: bool,
+    /// Tentative collision rows for free nodes outside a collider but within
+    /// [`CONTACT_MARGIN`] of it (converge mode; see [`evaluate`]).
+    pub contact_margin: bool,
     /// Only the residual, the convergence test and the contacts (detected and remembered as
     /// usual): no segment rows are built. The projection's last evaluation, after its last
     /// solve, needs nothing more (one evaluation in `cap + 1` is this one).
@@ -183,8 +215,13 @@ pub struct Rows<const N: usize> {
     pub count: usize,
     /// Row index of segment `j`, or [`NO_ROW`].
     pub segment_row: [u16; N],
-    /// Each node's collision rows.
+    /// Each node's collision rows (all empty, `kept = 0`, but those of `contact_nodes`).
     pub contacts: [NodeContacts; N],
+    /// The nodes with collision rows at this iterate, in increasing order (`contact_count`
+    /// in use): the collision work of the solve visits these only.
+    pub contact_nodes: [u16; N],
+    /// Entries of `contact_nodes` in use.
+    pub contact_count: usize,
     /// `max_j |C_j| / (ê^j·ê^j)` over segment rows and `depth / |ê^{i−1}|` over nodes inside a
     /// collider (with or without a row): the relative residual at this iterate.
     pub residual: Real,
@@ -195,6 +232,8 @@ pub struct Rows<const N: usize> {
     pub max_depth: Real,
     /// Whether some node was in more than [`MAX_NODE_CONTACTS`] colliders.
     pub truncated: bool,
+    /// Whether some node carries a tentative collision row.
+    pub tentative: bool,
 }
 
 impl<const N: usize> Default for Rows<N> {
@@ -205,10 +244,13 @@ impl<const N: usize> Default for Rows<N> {
             count: 0,
             segment_row: [NO_ROW; N],
             contacts: [NodeContacts::default(); N],
+            contact_nodes: [0; N],
+            contact_count: 0,
             residual: 0.0,
             converged: true,
             max_depth: 0.0,
             truncated: false,
+            tentative: false,
         }
     }
 }
@@ -218,6 +260,12 @@ impl<const N: usize> Rows<N> {
     #[must_use]
     pub fn rows(&self) -> &[Row] {
         self.rows.get(..self.count).unwrap_or(&[])
+    }
+
+    /// The nodes with collision rows at this iterate, in increasing order.
+    #[must_use]
+    pub fn contact_nodes(&self) -> &[u16] {
+        self.contact_nodes.get(..self.contact_count).unwrap_or(&[])
     }
 
     /// The envelope starts of the rows in use.
@@ -334,6 +382,13 @@ fn surface<M: Math>(shape: &Shape, p: Vec3) -> (Vec3, Real) {
 /// then flickers and the iteration does not settle. Keeping a row that pulls would glue the
 /// node to the surface, which can be infeasible with the segment lengths (a node held at the
 /// surface out of reach of the root).
+///
+/// With `layout.contact_margin` (converge mode), a free node outside a collider but within
+/// [`CONTACT_MARGIN`] of it gets a *tentative* row (`C > 0`, same secant gradient): the
+/// solve keeps it only if its multiplier pushes (see `project_constraints`), so a node that
+/// the segments would pull into the collider is held at its surface in the same iteration
+/// instead of being caught one iteration later. A kept tentative row becomes a contact
+/// (`touched`); one that pulls leaves no trace.
 pub fn evaluate<M: Math, const N: usize>(
     strand: &Strand<N>,
     nodes: &Nodes<N>,
@@ -348,6 +403,7 @@ pub fn evaluate<M: Math, const N: usize>(
     rows.converged = true;
     rows.max_depth = 0.0;
     rows.truncated = false;
+    rows.tentative = false;
     let count = nodes.count.min(N);
     // Without collision slots no node ever gets a contact (counts stay 0 from `Default`).
     if layout.contact_slots > 0 {
@@ -365,7 +421,67 @@ pub fn evaluate<M: Math, const N: usize>(
     }
 }
 
-/// The collision rows of every free node at this iterate (see [`evaluate`]).
+/// How far outside a collider a free node gets a tentative collision row, as a fraction of
+/// the rest length of the segment before it (see [`evaluate`]). Measured on Table 3's draped
+/// strands: nodes a few µm outside the head at the first iterate were pushed 30–45 µm in by
+/// the first solve (the segments' shortening pulls the draped run onto its chords), and each
+/// such strand needed a third iteration to push them back out.
+pub const CONTACT_MARGIN: Real = 5.0e-3;
+
+/// Outward normal and signed depth (> 0 inside) of `p` against `shape` when `p` is inside it
+/// or within `margin` outside; the same geometry as [`Shape::penetration`] (a square root only
+/// for nodes that pass the squared-distance test).
+#[inline(always)]
+fn near_surface<M: Math>(shape: &Shape, p: Vec3, margin: Real) -> Option<(Vec3, Real)> {
+    let ball = |centre: Vec3, radius: Real| {
+        let d = p - centre;
+        let distance2 = d.dot(d);
+        let reach = radius + margin;
+        if distance2 >= reach * reach {
+            return None;
+        }
+        let distance = M::sqrt(distance2);
+        let normal = if distance > 0.0 {
+            d / distance
+        } else {
+            Vec3::Y
+        };
+        Some((normal, radius - distance))
+    };
+    match *shape {
+        Shape::Sphere { centre, radius } => ball(centre, radius),
+        Shape::Capsule { a, b, radius } => {
+            ball(crate::collide::closest_on_segment(p, a, b), radius)
+        }
+        Shape::Plane { point, normal } => {
+            let height = (p - point).dot(normal);
+            (height < margin).then_some((normal, -height))
+        }
+    }
+}
+
+/// Whether `p` is surely further than `margin` outside `shape`: the squared-distance test of
+/// [`near_surface`] alone, no square root.
+#[inline(always)]
+fn beyond(shape: &Shape, p: Vec3, margin: Real) -> bool {
+    match *shape {
+        Shape::Sphere { centre, radius } => {
+            let d = p - centre;
+            let reach = radius + margin;
+            d.dot(d) >= reach * reach
+        }
+        Shape::Capsule { a, b, radius } => {
+            let d = p - crate::collide::closest_on_segment(p, a, b);
+            let reach = radius + margin;
+            d.dot(d) >= reach * reach
+        }
+        Shape::Plane { point, normal } => (p - point).dot(normal) >= margin,
+    }
+}
+
+/// The collision rows of every free node at this iterate (see [`evaluate`]). One collider
+/// at a time over the nodes, so that the common case — a node far from it — is a
+/// squared-distance test in a tight loop; each node still gets its rows in collider order.
 fn detect_contacts<M: Math, const N: usize>(
     strand: &Strand<N>,
     nodes: &Nodes<N>,
@@ -378,29 +494,46 @@ fn detect_contacts<M: Math, const N: usize>(
     let x = &strand.state.position;
     let rest_length = &strand.rest.segment_length;
     let count = nodes.count.min(N);
-    for i in 0..count {
-        rows.contacts[i].count = 0;
-        if colliders.is_empty() || !nodes.is_free(i) {
-            continue;
+    // The previous iterate's rows: every other node's are empty already.
+    for k in 0..rows.contact_count.min(N) {
+        if let Some(contacts) = rows.contacts.get_mut(usize::from(rows.contact_nodes[k])) {
+            (contacts.count, contacts.tentative, contacts.kept) = (0, 0, 0);
         }
-        for &(c, ref shape) in colliders {
-            let bit = 1u8 << (c % 8);
+    }
+    rows.contact_count = 0;
+    let margin_fraction = if layout.contact_margin && !layout.residual_only {
+        CONTACT_MARGIN
+    } else {
+        0.0
+    };
+    let mut ordered = true;
+    for &(c, ref shape) in colliders {
+        let bit = 1u8 << (c % 8);
+        // Nodes 0 and 1 are prescribed (root coupling): never a row.
+        for i in 2..count {
+            let free = nodes.is_free(i);
             // Test the bit first: most nodes never touch anything.
-            let sticky = memory.touched[i] & bit != 0
+            let remembered = memory.touched[i] & bit != 0;
+            let margin = margin_fraction * rest_length[i - 1];
+            if !free || (!remembered && beyond(shape, x[i], margin)) {
+                continue;
+            }
+            let sticky = remembered
                 && memory.multipliers[i]
                     .get(usize::from(c))
                     .is_some_and(|&lambda| lambda < 0.0);
             let found = if sticky {
                 Some(surface::<M>(shape, x[i]))
+            } else if margin > 0.0 {
+                near_surface::<M>(shape, x[i], margin)
             } else {
                 shape.penetration::<M>(x[i]).map(|c| (c.normal, c.depth))
             };
             let Some((normal, depth)) = found else {
                 continue;
             };
+            let scale = rest_length[i - 1];
             if depth > 0.0 {
-                // Node i ≥ 2 when free, so the segment before it exists.
-                let scale = rest_length[i.saturating_sub(1)];
                 rows.residual = rows.residual.max(depth / scale);
                 rows.max_depth = rows.max_depth.max(depth);
                 if rows.converged && depth > tolerance * scale {
@@ -413,12 +546,39 @@ fn detect_contacts<M: Math, const N: usize>(
                     rows.converged = depth <= floor;
                 }
             }
+            let tentative = !sticky && depth <= 0.0;
             let (value, gradient) = contact(shape, normal, depth);
-            let room = usize::from(rows.contacts[i].count) < layout.contact_slots;
-            if room && rows.contacts[i].push(c, value, gradient) {
-                memory.touched[i] |= bit;
-            } else {
+            let contacts = &mut rows.contacts[i];
+            let first = contacts.count == 0;
+            let room = usize::from(contacts.count) < layout.contact_slots
+                || (!tentative && contacts.tentative != 0);
+            if room && contacts.push(c, value, gradient, tentative) {
+                if tentative {
+                    rows.tentative = true;
+                } else {
+                    memory.touched[i] |= bit;
+                }
+                if first {
+                    let last = rows.contact_count.checked_sub(1);
+                    ordered &= last.is_none_or(|k| usize::from(rows.contact_nodes[k]) < i);
+                    if let Some(slot) = rows.contact_nodes.get_mut(rows.contact_count) {
+                        *slot = i as u16;
+                        rows.contact_count += 1;
+                    }
+                }
+            } else if !tentative {
                 rows.truncated = true;
+            }
+        }
+    }
+    if !ordered {
+        // A later collider touched an earlier node: list them in node order again (the
+        // solve's sums must not depend on the colliders' order).
+        rows.contact_count = 0;
+        for i in 2..count {
+            if rows.contacts[i].count > 0 {
+                rows.contact_nodes[rows.contact_count] = i as u16;
+                rows.contact_count += 1;
             }
         }
     }

@@ -5,12 +5,14 @@
 //! Each iteration `k` (at most `RodParams::projection_iterations`):
 //! 1. evaluate `C(x_k)` and `∇C(x_k)`: inextensibility of every segment with a free node,
 //!    and collision rows for the free nodes found inside a collider *at this iterate* (a node
-//!    pushed in by the projection is caught in the same step) — [`constraints`];
+//!    pushed in by the projection is caught in the same step) — [`constraints`]; in converge
+//!    mode also *tentative* rows for nodes just outside, kept only where they push (step 3);
 //! 2. stop if `max_j |C_j| / (ê^j·ê^j) ≤ tol` (converge mode only; a row within what f32
 //!    positions can resolve counts as met — see [`constraints::resolution_floor`]);
 //! 3. solve `(∇C M⁻¹ ∇Cᵀ) δλ = C(x_k)` with a banded LDLᵀ — [`banded`]: each node's collision
 //!    rows are eliminated first at their node (no fill), leaving the segments' tridiagonal
-//!    band, so contacts cost O(contacts) and never widen the band;
+//!    band, so contacts cost O(contacts) and never widen the band; tentative rows whose
+//!    multiplier pulls are removed and the system solved again (at most three times);
 //! 4. `x_{k+1} = x_k − M⁻¹ ∇C(x_k)ᵀ δλ`, scaled down whole if it would move a node further
 //!    than ten strand lengths (a trust region that only garbage input meets).
 //!
@@ -132,6 +134,9 @@ pub fn project_constraints<M: Math, const N: usize>(
             0
         },
         fixed_cost: ctx.params.mode == Mode::FixedCost,
+        // Tentative rows may cost a second solve: converge mode only, so that fixed cost
+        // keeps one solve per iteration.
+        contact_margin: collisions && ctx.params.mode == Mode::Converge,
         residual_only: false,
     };
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
@@ -483,13 +488,36 @@ fn solve_and_move<M: Math, const N: usize>(
     work: &mut Workspace<N>,
 ) -> Option<(u32, Real)> {
     let n = work.nodes.count.min(N);
-    let mut dropped = banded::eliminate_contacts(&mut work.rows, n);
+    let count = work.rows.count.min(N);
+    let mut dropped = 0;
+    // Tentative collision rows (converge mode) stay only where they push: a solve whose
+    // tentative rows pull is redone without those rows (an active-set step on the
+    // linearised contacts), twice at most, then once more without any tentative row (the
+    // solve without the margin) if some still pull. Only the last solve's dropped rows count.
+    // On Table 3's draped strands a second solve is needed in one iteration in five.
+    for pass in 0..4 {
+        dropped = banded::eliminate_contacts(&mut work.rows, n);
+        let band = work.band.get_mut(..count)?;
+        let multipliers = work.multipliers.get_mut(..count)?;
+        let (rows, first) = (work.rows.rows(), work.rows.first());
+        dropped += banded::solve_chain(rows, first, &work.nodes.inverse_mass, band, multipliers);
+        if !work.rows.tentative || !multipliers.iter().all(|l| l.is_finite()) {
+            break;
+        }
+        let all = pass >= 2;
+        if !prune_tentative(
+            &mut work.rows,
+            multipliers,
+            &work.nodes.inverse_mass,
+            n,
+            all,
+        ) {
+            break;
+        }
+        banded::undo_elimination(&mut work.rows);
+    }
     let rows = work.rows.rows();
-    let first = work.rows.first();
-    let count = rows.len();
-    let band = work.band.get_mut(..count)?;
-    let multipliers = work.multipliers.get_mut(..count)?;
-    dropped += banded::solve_chain(rows, first, &work.nodes.inverse_mass, band, multipliers);
+    let multipliers = work.multipliers.get(..count)?;
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
@@ -505,6 +533,9 @@ fn solve_and_move<M: Math, const N: usize>(
     // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
     // the next ones converged; a radius of one strand length cut that short and broke the
     // iteration. Hence ten strand lengths.
+    // Gathered per node from its two segments (segment i − 1 first, as the rows are in
+    // segment order) and its contacts, with the longest move in the same pass. A node
+    // without collision rows has `kept = 0` (see `Rows::contacts`).
     let mut any_contact = false;
     let mut longest2: Real = 0.0;
     let segment_row = &work.rows.segment_row;
@@ -562,10 +593,17 @@ fn solve_and_move<M: Math, const N: usize>(
         }
     }
     // Collider forces: only where a node kept a contact row this iteration.
-    let contact_nodes = if any_contact { n } else { 0 };
-    for i in 0..contact_nodes {
-        let contacts = work.rows.contacts[i];
-        if contacts.kept == 0 {
+    let contact_nodes = if any_contact {
+        work.rows.contact_count.min(N)
+    } else {
+        0
+    };
+    for k in 0..contact_nodes {
+        let i = usize::from(work.rows.contact_nodes[k]);
+        let Some(&contacts) = work.rows.contacts.get(i) else {
+            continue;
+        };
+        if contacts.kept == 0 || i >= n {
             continue;
         }
         let segment_pull = segment_pull_on_node(&work.rows, multipliers, i);
@@ -586,9 +624,52 @@ fn solve_and_move<M: Math, const N: usize>(
             if let Some(sum) = work.contacts.multipliers[i].get_mut(c) {
                 *sum += lambda * scale;
             }
+            // A tentative row that stayed pushes: a contact from now on.
+            work.contacts.touched[i] |= 1 << (c % 8);
         }
     }
     Some((dropped, longest2))
+}
+
+/// Removes the tentative collision rows whose multiplier does not push (`δλ ≥ 0`: the row
+/// would hold its node at the surface against the segments pulling it away), or every
+/// tentative row when `all`. Returns whether any row was removed (the system must be solved
+/// again); `rows.tentative` then says whether tentative rows are left.
+fn prune_tentative<const N: usize>(
+    rows: &mut Rows<N>,
+    multipliers: &[Real],
+    inverse_mass: &[Real; N],
+    n: usize,
+    all: bool,
+) -> bool {
+    let mut removed = false;
+    let mut left = false;
+    for k in 0..rows.contact_count.min(N) {
+        let i = usize::from(rows.contact_nodes[k]);
+        let (Some(&contacts), Some(&w)) = (rows.contacts.get(i), inverse_mass.get(i)) else {
+            continue;
+        };
+        if contacts.tentative == 0 || i >= n {
+            continue;
+        }
+        let mut pulling = contacts.tentative;
+        if !all {
+            let segment_pull = segment_pull_on_node(rows, multipliers, i);
+            let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
+            for (k, &lambda) in lambdas.iter().enumerate() {
+                if lambda < 0.0 {
+                    pulling &= !(1 << k);
+                }
+            }
+        }
+        if pulling != 0 {
+            rows.contacts[i].remove(pulling);
+            removed = true;
+        }
+        left |= rows.contacts[i].tentative != 0;
+    }
+    rows.tentative = left;
+    removed
 }
 
 /// `Σ_s ∇_{x_i}C_s δλ_s` over the (at most two) segments through node `i`, with the gradients

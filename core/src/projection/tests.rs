@@ -497,3 +497,102 @@ fn strands_far_from_a_collider_skip_it_and_strands_on_it_do_not() {
     let mut none = NearColliders::new(&strand, &work.nodes, &shapes, true);
     assert!(none.shapes(&shapes).is_empty());
 }
+
+#[test]
+fn a_node_just_outside_that_moves_away_is_not_held() {
+    // A strand 20 µm above a floor (within the tentative margin, 50 µm at 1 cm segments),
+    // perturbed upward: the solve lifts the nodes, so every tentative row pulls and is
+    // removed. The result is the projection without the floor, bit for bit, and the floor
+    // feels nothing.
+    let floor = Collider {
+        shape: Shape::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        },
+        attached_to_head: false,
+    };
+    let mut strand = line(20, Vec3::new(0.0, 2.0e-5, 0.0), Vec3::X);
+    for i in 2..20 {
+        let k = i as Real;
+        strand.state.position[i] += Vec3::new(0.0, 0.002 * (k * 1.3).sin().abs(), 0.0);
+    }
+    let mut results: [(Strand<N>, StepReport, Outcome); 2] =
+        core::array::from_fn(|_| (strand.clone(), StepReport::default(), Outcome::default()));
+    for (collisions, (strand, report, outcome)) in results.iter_mut().enumerate() {
+        let effects: &[Effect] = if collisions == 1 {
+            &[Effect::Inextensibility, Effect::Collisions]
+        } else {
+            &[Effect::Inextensibility]
+        };
+        let p = params(effects, Mode::Converge, 30, 1.0e-6);
+        let ctx = context(&p, &[floor]);
+        *outcome = project_constraints::<Libm, N>(strand, &ctx, &[], 0, report);
+    }
+    let [(free, _, free_outcome), (floored, report, outcome)] = &results;
+    assert!(floored.positions().iter().all(|x| x.y > 0.0));
+    assert_eq!(free.positions(), floored.positions());
+    assert_eq!(free_outcome.iterations, outcome.iterations);
+    assert_eq!(report.contacts, 0);
+    assert_eq!(report.collider_forces[0], Vec3::ZERO);
+}
+
+#[test]
+fn a_node_just_outside_that_the_segments_pull_in_is_held_in_the_same_iteration() {
+    // A strand draped over a sphere 1 µm off its surface, every segment 1 % too long: the
+    // solve shortens the segments, pulling the nodes onto their chords, into the sphere.
+    // Tentative rows hold them at the surface in the first solve, so collisions cost no
+    // iteration over the projection without the sphere, and the nodes end outside.
+    let radius: Real = 0.1;
+    let sphere = Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius,
+        },
+        attached_to_head: false,
+    };
+    // Rest shape: 1 cm chords of the circle of radius r + 1 µm in the x–y plane.
+    let arc = radius + 1.0e-6;
+    let step = 2.0 * libm::asinf(0.005 / arc);
+    let on_arc = |i: usize, scale: Real| {
+        let angle = 0.3 - step * scale * i as Real;
+        Vec3::new(libm::cosf(angle), libm::sinf(angle), 0.0) * arc
+    };
+    let points: [Vec3; 15] = core::array::from_fn(|i| on_arc(i, 1.0));
+    let rest = Strand::<N>::from_polyline(&points, &Material::HUMAN_HAIR).unwrap();
+    let mut iterations = [0; 2];
+    for (collisions, used) in iterations.iter_mut().enumerate() {
+        let mut strand = rest.clone();
+        for i in 2..15 {
+            strand.state.position[i] = on_arc(i, 1.01);
+        }
+        let effects: &[Effect] = if collisions == 1 {
+            &[Effect::Inextensibility, Effect::Collisions]
+        } else {
+            &[Effect::Inextensibility]
+        };
+        let p = params(effects, Mode::Converge, 30, 1.0e-6);
+        let ctx = context(&p, &[sphere]);
+        let mut report = StepReport::default();
+        let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report);
+        assert!(outcome.converged);
+        *used = outcome.iterations;
+        if collisions == 1 {
+            assert!(
+                report.contacts > 5,
+                "the test needs contacts: {}",
+                report.contacts
+            );
+            for (i, x) in strand.positions().iter().enumerate() {
+                let depth = sphere
+                    .shape
+                    .penetration::<Libm>(*x)
+                    .map_or(0.0, |c| c.depth);
+                assert!(depth <= 1e-7, "node {i} {depth} m deep");
+            }
+            // The hair presses on the sphere: towards its centre, here −x mostly.
+            let force = report.collider_forces[0];
+            assert!(force.dot(on_arc(7, 1.0)) < 0.0, "{force}");
+        }
+    }
+    assert_eq!(iterations[0], iterations[1], "{iterations:?}");
+}
