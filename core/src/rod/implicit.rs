@@ -247,41 +247,45 @@ fn node_blocks<M: Math, const N: usize>(
     let kb_unit = t_prev.cross(t_next) * (2.0 / (1.0 + t_prev.dot(t_next)));
     let first = 0.5 * frames.inverse_length[i - 1];
     let last = -0.5 * frames.inverse_length[i];
-    let gamma = [first, -(first + last), last];
-    let kk = gram(
-        &[
-            kb_unit * kb_unit.x,
-            kb_unit * kb_unit.y,
-            kb_unit * kb_unit.z,
-        ],
-        &[Vec3::X, Vec3::Y, Vec3::Z],
-    );
-    // Axial term of segment i.
-    let t = t_next;
+    let middle = -(first + last);
+    let kk = outer(kb_unit);
+    // Axial term of segment i (nodes i, i + 1).
     let axial = AXIAL_PENALTY * 0.5 * (mass[i] + mass[i + 1]);
-    let tt = gram(&[t * t.x, t * t.y, t * t.z], &[Vec3::X, Vec3::Y, Vec3::Z]);
+    let tt = outer(t_next);
+    let hol = [
+        holonomy * first * first,
+        holonomy * middle * first,
+        holonomy * middle * middle,
+        holonomy * last * first,
+        holonomy * last * middle,
+        holonomy * last * last,
+    ];
     let mut blocks = [[[0.0; 3]; 3]; 6];
     for p in 0..3 {
         for q in 0..3 {
-            let bending = [
-                aa[p][q],
-                ac[q][p] - aa[p][q],
-                aa[p][q] - ac[p][q] - ac[q][p] + cc[p][q],
-                -ac[q][p],
-                ac[q][p] - cc[p][q],
-                cc[p][q],
-            ];
-            let pairs = [(0, 0), (1, 0), (1, 1), (2, 0), (2, 1), (2, 2)];
-            let stretch = [0.0, 0.0, axial, 0.0, -axial, axial];
-            for (((block, bend), (ka, kb)), stretch) in
-                blocks.iter_mut().zip(bending).zip(pairs).zip(stretch)
-            {
-                block[p][q] =
-                    s * bend + holonomy * gamma[ka] * gamma[kb] * kk[p][q] + stretch * tt[p][q];
-            }
+            // J = (−A, A − C, C): J_aᵀJ_b from AᵀA, CᵀC, AᵀC (ac[q][p] = c_p·a_q).
+            let (aa, cc, ac, ca) = (aa[p][q], cc[p][q], ac[p][q], ac[q][p]);
+            let (kk, tt) = (kk[p][q], tt[p][q]);
+            blocks[0][p][q] = s * aa + hol[0] * kk;
+            blocks[1][p][q] = s * (ca - aa) + hol[1] * kk;
+            blocks[2][p][q] = s * (aa - ac - ca + cc) + hol[2] * kk + axial * tt;
+            blocks[3][p][q] = -(s * ca) + hol[3] * kk;
+            blocks[4][p][q] = s * (ca - cc) + hol[4] * kk - axial * tt;
+            blocks[5][p][q] = s * cc + hol[5] * kk + axial * tt;
         }
     }
     blocks
+}
+
+/// `u uᵀ`.
+#[inline(always)]
+fn outer(u: Vec3) -> [[Real; 3]; 3] {
+    let [x, y, z] = u.to_array();
+    [
+        [x * x, x * y, x * z],
+        [y * x, y * y, y * z],
+        [z * x, z * y, z * z],
+    ]
 }
 
 /// Adds `block` to the rows `rows` of one node at column node `OFFSET` nodes back (lower
@@ -302,19 +306,20 @@ fn add_block<const OFFSET: usize>(rows: &mut [BandRow; 3], block: &[[Real; 3]; 3
 /// `r − BAND + k`, `inverse_pivot[k]` its `1/D`. Returns `1/D(r)`.
 #[inline(always)]
 fn factor_row(row: &mut BandRow, previous: &[BandRow; BAND], inverse_pivot: &[Real; BAND]) -> Real {
-    // ld[m] = L(r, r − m) D(r − m), filled from the farthest column in.
+    // ld[m] = L(r, r − m) D(r − m), filled from the farthest column in. (Exclusive ranges:
+    // `a..=b` iterates with an extra check per step.)
     let mut ld = [0.0; BAND + 1];
-    for m in (1..=BAND).rev() {
+    for m in (1..BAND + 1).rev() {
         let column = &previous[BAND - m];
         let mut sum = row[m];
-        for q in m + 1..=BAND {
+        for q in m + 1..BAND + 1 {
             sum -= ld[q] * column[q - m];
         }
         ld[m] = sum;
         row[m] = sum * inverse_pivot[BAND - m];
     }
     let mut pivot = row[0];
-    for m in 1..=BAND {
+    for m in 1..BAND + 1 {
         pivot -= row[m] * ld[m];
     }
     row[0] = pivot;
@@ -474,8 +479,8 @@ impl<const N: usize> BendingSystem<N> {
             let row = &band[r];
             let start = r.saturating_sub(BAND);
             let mut sum = z[r];
-            for (m, previous) in (1..=BAND).zip(z[start..r].iter().rev()) {
-                sum -= row[m] * *previous;
+            for (l, previous) in row[1..].iter().zip(z[start..r].iter().rev()) {
+                sum -= *l * *previous;
             }
             z[r] = sum;
         }
@@ -485,11 +490,15 @@ impl<const N: usize> BendingSystem<N> {
         // Lᵀ x = y: z[r] −= Σ_m L(r + m, r) z[r + m].
         for r in (FIRST_ROW..rows).rev() {
             let end = rows.min(r + BAND + 1);
-            let mut sum = z[r];
-            for (m, (below, value)) in band[r + 1..end].iter().zip(&z[r + 1..end]).enumerate() {
-                sum -= below[m + 1] * *value;
+            let (head, tail) = z.split_at_mut(r + 1);
+            let (Some(value), Some(below)) = (head.last_mut(), band.get(r + 1..end)) else {
+                continue;
+            };
+            let mut sum = *value;
+            for (m, (row, solved)) in below.iter().zip(tail.iter()).enumerate() {
+                sum -= row[m + 1] * *solved;
             }
-            z[r] = sum;
+            *value = sum;
         }
     }
 }
