@@ -217,10 +217,7 @@ fn hair_hair_runs_when_called_for_and_is_thread_independent() {
     let without = go(1, &scene);
     scene.effects.push("hair-hair".into());
     scene.hair_hair = Some(hairsim::scene::HairHairSpec {
-        // 4 cm: with 2 cm the runs with and without hair-hair ended on the same bits once the
-        // rod's bending became implicit (the strands' 200 steps never brought nodes of
-        // different strands within 2 cm, it seems; 4 cm does).
-        smoothing_length: Some(0.04),
+        smoothing_length: Some(0.02),
         // Pressure everywhere (no rest density to stay under): strands push apart.
         rest_density: Some(0.0),
         stiffness: Some(0.5),

@@ -227,27 +227,25 @@ impl Params {
     };
 
     /// Checks that `strand` can be stepped stably with these parameters: with the rod solver and
-    /// bending on, `dt` must lie within [`crate::rod::step::MAX_STIFFNESS_RATIO`] times the
-    /// strand's explicit bending limit `dt_max` ([`crate::rod::step::within_tested_stiffness`]),
-    /// the range the implicit bending step is tested in (×1000 human hair at 1 cm and 1 ms).
-    /// Stiffer hair, shorter segments or a larger `µ` lower `dt_max` like
+    /// bending on, the fixed substep count that keeps explicit bending within its stability
+    /// bound ([`crate::rod::step::needed_substeps`]) must fit [`crate::rod::step::MAX_SUBSTEPS`].
+    /// Stiffer hair, shorter segments or a larger `µ` lower the limit like
     /// `h² / √(max(1, µ)·α)`; such a strand with too large a `dt` is refused here rather than
-    /// run outside what the tests cover.
+    /// left to chatter or explode.
     pub fn validate_strand<const N: usize>(
         &self,
         strand: &crate::strand::Strand<N>,
     ) -> Result<(), ParamError> {
         let bending = self.solver == Solver::Rod && self.effects.contains(Effect::Bending);
-        if crate::rod::step::within_tested_stiffness(&strand.rest.rod, self.dt, bending) {
-            Ok(())
-        } else {
-            Err(ParamError::OutOfRange {
+        match crate::rod::step::needed_substeps(&strand.rest.rod, self.dt, bending) {
+            Some(_) => Ok(()),
+            None => Err(ParamError::OutOfRange {
                 field: "dt",
-                allowed: "at most 22.4 times the strand's explicit bending limit (the tested \
-                          range of the implicit bending step): dt <= 22.4 * dt_max with \
-                          dt_max = (h^2/2) * sqrt(rho*A / (max(1, mu) * E*pi*r^4/4)) for the \
-                          shortest segment h; use a smaller dt, longer segments or softer hair",
-            })
+                allowed: "at most 128 substeps' worth of the strand's explicit bending limit: \
+                          dt <= 128 * 0.7 * dt_max / 4 with dt_max = (h^2/2) * sqrt(rho*A / \
+                          (max(1, mu) * E*pi*r^4/4)) for the shortest segment h; use a smaller \
+                          dt, longer segments or softer hair",
+            }),
         }
     }
 
@@ -268,8 +266,9 @@ impl Params {
         range(
             self.solver != Solver::Rod || self.dt <= ROD_MAX_DT,
             "dt",
-            "1e-5 s to 0.004 s with the rod solver (the twist and the projection run once per \
-             step: on a head shaking at 10 rad/s the rod holds at 4 ms, tests/torture.rs)",
+            "1e-5 s to 0.004 s with the rod solver (bending is substepped, but the twist and the \
+             projection run once per step: on a head shaking at 10 rad/s the rod holds at \
+             4 ms and diverges at 5 ms, tests/torture.rs)",
         )?;
         range(
             crate::math::is_finite(self.gravity),

@@ -53,10 +53,7 @@ fn world(
     (w, points)
 }
 
-/// Largest distance from the rest shape (placed by `head`) after 10 s of steps, gravity off,
-/// inextensibility on (as in every rod scene: without it the segment lengths carry no energy,
-/// and the rounding of a turned rest shape walked a 2 mm-pitch helix 3–9e-6 m along them in
-/// 10 s under the implicit step, whose axial term damps but does not restore them).
+/// Largest distance from the rest shape (placed by `head`) after 10 s of steps, gravity off.
 fn rest_drift(shape: usize, mu: Real, twist: TwistMethod, head: Pose, drag: Real) -> Real {
     let material = Material {
         minor_axis_penalty: mu,
@@ -65,7 +62,6 @@ fn rest_drift(shape: usize, mu: Real, twist: TwistMethod, head: Pose, drag: Real
     let effects = Effects::NONE
         .with(Effect::Bending)
         .with(Effect::Twist)
-        .with(Effect::Inextensibility)
         .with(Effect::Drag);
     let mut params = Params {
         effects,
@@ -105,9 +101,8 @@ fn rest_shapes_stay_at_rest_for_ten_seconds() {
     // ~1e-6 rad per node whose elastic energy (~1e-17 J), once shared with the softest mode of
     // a 19 cm human hair (k ≈ 3α/L³ ≈ 3e-6 N/m), moves the tip by up to √(2E/k) ≈ 3e-6 m — the
     // f32 floor for floppy hair. With the firmware scene's air drag (2e-7 kg/s) and the
-    // implicit bending step, we measure ≤ 0.4e-6 m (helix; 0.69e-6 m after 20 s; straight and
-    // wavy ≤ 1.7e-8 m) and bound it by 1.1e-6 m (the explicit substeps measured 0.35–1.00e-6
-    // m without inextensibility).
+    // substeps' displacement summed before it is added to the positions, we measure
+    // 0.35–1.00e-6 m (1.0e-6 m: straight, µ = 2, hair-optimised) and bound it by 1.1e-6 m.
     let turned = Pose {
         position: Vec3::new(0.1, 0.05, -0.05),
         rotation: crate::math::quat_from_axis_angle::<Libm>(Vec3::new(0.36, 0.48, 0.8), 0.9),
@@ -129,9 +124,8 @@ fn rest_shapes_stay_at_rest_for_ten_seconds() {
 }
 
 #[test]
-fn the_tested_stiffness_range_reaches_a_thousand_times_human_hair() {
-    // dt / dt_max at 1 cm and 1 ms: 0.66 √factor (dt_max = 1.52 ms / √factor).
-    let accepted: std::vec::Vec<bool> = [1.0, 1000.0, 1300.0]
+fn substeps_follow_the_stability_bound() {
+    let counts: std::vec::Vec<u32> = [1.0, 10.0, 100.0, 1000.0]
         .iter()
         .map(|factor| {
             let material = Material {
@@ -139,10 +133,67 @@ fn the_tested_stiffness_range_reaches_a_thousand_times_human_hair() {
                 ..Material::HUMAN_HAIR
             };
             let s = Strand::<NODES>::from_polyline(&polyline(0, 20)[..20], &material).unwrap();
-            within_tested_stiffness(&s.rest.rod, 0.001, true)
+            substeps(&s.rest.rod, 0.001, true)
         })
         .collect();
-    assert_eq!(accepted, [true, true, false]);
+    // ⌈4 · dt / (0.7 · dt_max)⌉ with dt_max = 1.52 ms / √factor.
+    std::println!("fixed substeps at 1 cm, 1 ms, ×1/×10/×100/×1000: {counts:?}");
+    assert_eq!(counts, [4, 12, 38, 119]);
+    // Human hair keeps its substeps; from ×10 on a strand takes the implicit step.
+    assert!(counts[0] < IMPLICIT_FROM && counts[1] >= IMPLICIT_FROM);
+}
+
+#[test]
+fn substeps_grow_as_the_binormal_denominator_shrinks() {
+    let s = Strand::<NODES>::from_polyline(&polyline(0, 20)[..20], &Material::HUMAN_HAIR).unwrap();
+    let rest = &s.rest.rod;
+    let dt = 0.004;
+    let ratio = dt / (SAFETY * rest.stable_time_step);
+    // Straight (g = 2): the rest count; g = 0.5 (φ = 2.09 rad): 4× the work; a fold (g ≤ 0
+    // or NaN): the cap; bending off: 1.
+    assert_eq!(
+        substeps_for_shape(rest, dt, true, 2.0),
+        libm::ceilf(ratio) as u32
+    );
+    assert_eq!(
+        substeps_for_shape(rest, dt, true, 2.5),
+        libm::ceilf(ratio) as u32
+    );
+    // The fixed count is the count at the allowance, g = 2 / FOLD_ALLOWANCE.
+    assert_eq!(
+        substeps_for_shape(rest, dt, true, 0.5),
+        libm::ceilf(4.0 * ratio) as u32
+    );
+    assert_eq!(substeps(rest, dt, true), libm::ceilf(4.0 * ratio) as u32);
+    let mut previous = 0;
+    for g in [2.0, 1.5, 1.0, 0.5, 0.25, 0.1, 0.01] {
+        let k = substeps_for_shape(rest, dt, true, g);
+        assert!(
+            k >= previous && k <= MAX_SUBSTEPS,
+            "g {g}: {k} after {previous}"
+        );
+        previous = k;
+    }
+    assert_eq!(substeps_for_shape(rest, dt, true, 0.0), MAX_SUBSTEPS);
+    assert_eq!(substeps_for_shape(rest, dt, true, -0.3), MAX_SUBSTEPS);
+    assert_eq!(substeps_for_shape(rest, dt, true, Real::NAN), MAX_SUBSTEPS);
+    assert_eq!(substeps_for_shape(rest, dt, false, 0.0), 1);
+}
+
+#[test]
+fn smallest_binormal_denominator_is_one_plus_cos_of_the_sharpest_turn() {
+    // Three segments at rest length, turning by 0.3 rad then 1.9 rad.
+    let mut points = [Vec3::ZERO; NODES];
+    let mut direction: Real = 0.0;
+    for (i, turn) in [0.0, 0.3, 1.9].iter().enumerate() {
+        direction += turn;
+        let (sin, cos) = libm::sincosf(direction);
+        points[i + 1] = points[i] + Vec3::new(cos, sin, 0.0) * 0.01;
+    }
+    let s = Strand::<NODES>::from_polyline(&points[..4], &Material::HUMAN_HAIR).unwrap();
+    let frames = strand_frames::<Libm, NODES>(&s);
+    let g = smallest_binormal_denominator(&frames, &s.rest.rod.rest_length);
+    assert!((g - (1.0 + libm::cosf(1.9))).abs() < 1e-5, "{g}");
 }
 
 /// Turning angles `φ_i` at the interior nodes.
@@ -170,13 +221,22 @@ fn chatter(strand: &Strand<NODES>) -> Real {
 /// Runs 3 s of a horizontal strand falling (or falling while the head shakes at 10 rad/s)
 /// with the length restoration after each step; returns the largest `|Δ²φ|` seen, or `None`
 /// if the strand was rolled back.
-fn worst_chatter(material: &Material, twist: TwistMethod, swinging: bool) -> Option<Real> {
+fn worst_chatter(
+    material: &Material,
+    twist: TwistMethod,
+    swinging: bool,
+    explicit: bool,
+) -> Option<Real> {
     let effects = Effects::NONE
         .with(Effect::Gravity)
         .with(Effect::Bending)
         .with(Effect::Twist)
         .with(Effect::Inextensibility);
     let (mut w, _) = world(0, material, effects, twist);
+    if explicit {
+        // The control: one substep whatever the stiffness.
+        w.strands_mut()[0].rest.rod.stable_time_step = Real::INFINITY;
+    }
     let mut worst: Real = 0.0;
     for k in 0..3000u32 {
         let head = if swinging {
@@ -214,7 +274,7 @@ fn stiff_hair_hangs_and_swings_without_chatter() {
         let bound = if factor > 1.0 { 0.5 } else { 1.0 };
         for twist in [TwistMethod::HairOptimised, TwistMethod::Newton] {
             for swinging in [false, true] {
-                let worst = worst_chatter(&stiff(factor), twist, swinging);
+                let worst = worst_chatter(&stiff(factor), twist, swinging, false);
                 std::println!("×{factor} {twist:?} swinging {swinging}: max |Δ²φ| = {worst:?} rad");
                 let worst = worst.unwrap_or_else(|| panic!("×{factor} {twist:?}: rolled back"));
                 assert!(
@@ -224,6 +284,14 @@ fn stiff_hair_hangs_and_swings_without_chatter() {
             }
         }
     }
+}
+
+#[test]
+fn without_substeps_stiff_hair_chatters() {
+    // The control for the test above: the same ×100 strand with a single explicit substep.
+    let worst = worst_chatter(&stiff(100.0), TwistMethod::HairOptimised, false, true);
+    std::println!("×100 explicit: {worst:?}");
+    assert!(worst.is_none_or(|w| w > 1.0), "{worst:?}");
 }
 
 #[test]
