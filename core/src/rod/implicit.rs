@@ -1,5 +1,7 @@
 //! Linearly implicit bending: one elastic step per time step at any bending stiffness the
-//! validator accepts, with a banded solve per strand in fixed storage (DESIGN.md "Stiff hair").
+//! validator accepts, with a banded solve per strand in fixed storage. A strand takes it when
+//! it would need [`IMPLICIT_FROM`](super::step::IMPLICIT_FROM) or more explicit substeps
+//! (stiffer than human hair, tight curls; `rod::step` says why not below).
 //!
 //! Symplectic Euler on the bending forces is only stable for `dt ≤ dt_max`
 //! ([`RodRest::stable_time_step`](super::energy::RodRest)); human hair at 1 cm and 1 ms sits
@@ -13,8 +15,10 @@
 //! Gauss–Newton matrix of `E_bend` with the material frames held and `B^j` bounded by its
 //! largest entry,
 //!
-//! `H̃ = Σ_i (2 b_i / l̂_i) J_iᵀ J_i`, `J_i = ∂(κb)_i / ∂(x_{i−1}, x_i, x_{i+1})`,
-//! `b_i = max(1, µ) max(α^{i−1}, α^i)`.
+//! `H̃ = Σ_i (2 b_i / l̂_i) J_iᵀ J_i + Σ_i D_i ∇ψ_i∇ψ_iᵀ + Σ_j k (t^j t^jᵀ on e^j)`,
+//! `J_i = ∂(κb)_i / ∂(x_{i−1}, x_i, x_{i+1})`, `b_i = max(1, µ) max(α^{i−1}, α^i)`:
+//! bending, a bound on the holonomy part ([`HOLONOMY_SHARE`], `holonomy_weights`) and an
+//! axial term that stands for inextensibility in the solve ([`AXIAL_PENALTY`]).
 //!
 //! For a straight strand at rest with `µ = 1` it is the exact Hessian (the test below checks
 //! it against finite differences of the forces); elsewhere it leaves out the terms weighted
