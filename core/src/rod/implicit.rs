@@ -156,7 +156,7 @@ fn node_jacobian<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize) ->
 pub const AXIAL_PENALTY: Real = 1.0e3;
 
 /// The share of the Gershgorin bound of the holonomy part taken into `H̃`
-/// ([`holonomy_weights`]).
+/// (`holonomy_weights`).
 ///
 /// Why not all of it: with 1 (a bound on the whole part, and in the linear analysis of the
 /// elastic step alone stable on a 2 mm curl) a 40-node 2 mm curl on a shaking head grew a slow
