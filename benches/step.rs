@@ -84,6 +84,30 @@ fn rod_table_1(c: &mut Criterion) {
     group.finish();
 }
 
+/// Head #1 with ×10 and ×100 human bending stiffness (12 and 38 explicit substeps' worth, so
+/// one linearly implicit bending step per strand, `core/src/rod/implicit.rs`): the step's cost
+/// should stay near the human-hair figure whatever the stiffness.
+fn stiff_hair(c: &mut Criterion) {
+    let mut group = c.benchmark_group("Head #1, stiffer hair (ms per step, one thread)");
+    for factor in [10.0f32, 100.0] {
+        let mut scene = (builtin::find("head-1").expect("built-in scene").scene)();
+        let mut material = scene.material.clone().unwrap_or_default();
+        material.youngs_modulus = Some(3.5e9 * factor);
+        scene.material = Some(material);
+        let prepared = scene.prepare().expect("valid stiff scene");
+        let mut sim = warmed_up(&prepared, WARM_UP_STEPS);
+        let mut k = WARM_UP_STEPS;
+        group.bench_function(format!("x{factor}"), |b| {
+            b.iter(|| {
+                let report = sim.step(&scene_inputs::<Libm>(&prepared, k));
+                k += 1;
+                report
+            })
+        });
+    }
+    group.finish();
+}
+
 fn firmware_step(c: &mut Criterion) {
     let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, Libm>> = Box::default();
     firmware::build(&mut world).unwrap();
@@ -97,5 +121,5 @@ fn firmware_step(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, rod_table_1, firmware_step);
+criterion_group!(benches, rod_table_1, stiff_hair, firmware_step);
 criterion_main!(benches);

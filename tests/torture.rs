@@ -406,11 +406,12 @@ fn head_sphere() -> Shape {
 #[test]
 fn stiff_hair_on_a_shaking_head() {
     // ×10, ×100, ×1000 human bending stiffness, 1 cm segments, dt = 1 ms, 20 nodes standing
-    // out of a shaking head (fixed substeps 12, 38, 119, the segment lengths projected after
-    // each). Measured: chatter ≤ 0.03 rad (×10, ×100) and ≤ 0.12 rad (×1000), speed ≤ 6.8
-    // m/s; bounds 0.3 rad (a saw-tooth reads ≥ 2–3) and 15 m/s. (Before the lengths were
-    // kept between substeps, ×10 gained energy from step ~600 and blew up near step 900, and
-    // ×100 reached 0.99 rad.)
+    // out of a shaking head: 12, 38, 119 explicit substeps' worth, so one linearly implicit
+    // bending step each (rod::implicit). Measured: chatter ≤ 0.0051 rad (×10), ≤ 0.0038 (×100),
+    // ≤ 0.0003 (×1000), speed ≤ 3.7 m/s; bounds 0.3 rad (a saw-tooth reads ≥ 2–3) and 15 m/s.
+    // (With the substeps, and the lengths projected after each: chatter ≤ 0.03 rad at ×10 and
+    // ×100, ≤ 0.12 at ×1000, speed ≤ 6.8 m/s; before the lengths were kept between substeps,
+    // ×10 gained energy from step ~600 and blew up near step 900, and ×100 reached 0.99 rad.)
     for factor in [10.0, 100.0, 1000.0] {
         for twist in TWISTS {
             for mode in [Mode::Converge, Mode::FixedCost] {
@@ -463,11 +464,12 @@ fn hundred_node_strands() {
 
 #[test]
 fn tight_curls_and_waves_at_one_millisecond() {
-    // A helix of radius 2 mm (2 mm segments, 1 cm pitch, 40 nodes: the rod needs 94 fixed
-    // substeps there) and a 1 cm wave (1 cm segments), on a shaking head at dt = 1 ms.
-    // Measured (rod): chatter ≤ 0.041 rad, speed ≤ 0.82 m/s; bounds 0.2 rad and 5 m/s.
-    // (Before the lengths were kept between substeps, the curl blew up within 30 steps even on
-    // a still head.)
+    // A helix of radius 2 mm (2 mm segments, 1 cm pitch, 40 nodes: 94 explicit substeps'
+    // worth, so the implicit bending step) and a 1 cm wave (1 cm segments, 4 substeps), on a
+    // shaking head at dt = 1 ms. Measured (rod): chatter ≤ 0.053 rad, speed ≤ 0.77 m/s; bounds
+    // 0.2 rad and 5 m/s. (With 94 substeps: ≤ 0.041 rad, ≤ 0.82 m/s; before the lengths were
+    // kept between substeps, the curl blew up within 30 steps even on a still head, and the
+    // implicit step needed its axial term for the same reason, rod::implicit::AXIAL_PENALTY.)
     let curl = helix(Vec3::new(0.0, -0.05, 0.0), 40, 0.002, 0.002, 0.01);
     let wave = wavy(Vec3::new(0.0, -0.05, 0.02), 30);
     for twist in TWISTS {
@@ -919,8 +921,8 @@ fn a_strand_at_rest_for_ten_seconds_does_not_flicker() {
             }
         }
     }
-    // Stiff rods take 38 and 119 substeps with the lengths projected between them: the
-    // same check for ×100 and ×1000 human hair (converge mode, cap 16).
+    // Stiff rods take the implicit bending step (38 and 119 substeps' worth): the same check
+    // for ×100 and ×1000 human hair (converge mode, cap 16).
     for factor in [100.0, 1000.0] {
         let mut world: Box<TortureWorld> = Box::default();
         world

@@ -8,6 +8,7 @@
 use crate::grab::{Grab, GrabStatus};
 
 pub mod energy;
+pub mod implicit;
 pub mod step;
 pub mod twist;
 

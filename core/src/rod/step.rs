@@ -34,15 +34,33 @@
 //! (`√µ` more for µ > 1), see the tests. Wall time of a whole step of one 30-node strand on a
 //! shaking head, fixed-cost mode, projection cap 8 (test profile, opt-level 2, on this 2-core
 //! machine at load average 12, so an upper figure): 91 µs (×1), 219 µs (×10), 518 µs (×100),
-//! 1089 µs (×1000). A linearly implicit bending step (banded, half-bandwidth 8 scalars)
-//! would cost about 3–4 explicit evaluations at any stiffness and so wins beyond ≈ ×1;
-//! substeps were kept because they integrate the very forces the finite-difference tests
-//! check (no linearisation, no linear solve, no artificial damping) and stay deterministic and
-//! bounded.
+//! 1089 µs (×1000) — the substep counts those figures were taken with; from 8 substeps on a
+//! strand now takes the implicit step below instead. Human hair keeps the substeps: they
+//! integrate the very forces the finite-difference tests check (no linearisation, no linear
+//! solve, no artificial damping), and at 4 substeps they cost no more than the implicit step.
+//!
+//! # Stiffer than human hair: one linearly implicit step
+//!
+//! From [`IMPLICIT_FROM`] = 8 fixed substeps on (×10 human hair at 1 cm and 1 ms: 12; ×1000:
+//! 119; 2 mm curls: 94), stages (1) and (2) are instead **one linearly implicit step**
+//! ([`super::implicit`]): `(M + dt² H̃) v⁺ = M (v + dt a)`, `x⁺ = x + dt v⁺`, with `a` the
+//! same explicit forces and `H̃` a banded positive semi-definite approximation of the bending
+//! Hessian (Gauss–Newton of the curvature binormals, a bound on the holonomy part, an axial
+//! term for the segment lengths), solved per strand in O(n) (half-bandwidth 8). Its cost does
+//! not grow with the stiffness: about 2.4 force evaluations on x86-64 (callgrind: frames
+//! ≈ 410, forces ≈ 380, matrix ≈ 800, factor ≈ 500, solve ≈ 330 instructions per node), more
+//! on the Cortex-M4F (the latency scene of 1 cm human hair, k = 4, measured 6,270 instructions
+//! per node per step implicit against 5,540 with the substeps), so human hair (k = 4) keeps
+//! its substeps and hair that needs 8 or more takes the implicit step. What it changes: the stiffest
+//! bending modes of the discrete strand (`dt²λ ≫ 1`, where a saw-tooth would live) lose
+//! energy each step instead of being resolved; slow motion and static equilibria are those
+//! of the explicit forces. The choice depends only on rest data and `dt` (set-up time, fixed
+//! cost).
 
 use super::energy::{
     elastic_forces_with_angles, material_angles, rest_root_frame, RodFrames, RodRest,
 };
+use super::implicit::BendingSystem;
 use super::twist::{hair_optimised_twist_with_angles, newton_twist, ClampedFrames, TwistMethod};
 use super::{ClampedSegments, ElasticTerms};
 use crate::context::StepContext;
@@ -65,6 +83,16 @@ pub const MAX_SUBSTEPS: u32 = 128;
 /// How much stiffer than straight the fixed substep count allows the strand to get by bending:
 /// `2/(1 + cos φ)` at the sharpest turning angle `φ`; 4 is `φ = 120°`.
 pub const FOLD_ALLOWANCE: Real = 4.0;
+
+/// Fewest fixed substeps ([`substeps`]) from which a strand takes one linearly implicit step
+/// instead: [`PROJECTED_SUBSTEPS_FROM`], where the substeps start to need a projection
+/// between them. Below it the substeps are cheaper or about as cheap (the implicit step costs
+/// about as much as 4–5 substeps on the Cortex-M4F, measured under QEMU, see the module
+/// documentation): human hair at 1 cm and 1 ms (4, and 6 with µ = 2) stays explicit, stiffer
+/// hair (×10: 12 and more) and tight curls do not pay for their stiffness. (With µ = 2 and
+/// 6 substeps switched to the implicit step, a turned helix without inextensibility drifted
+/// 7e-6 m in 10 s along its unconstrained segment lengths, `step::tests`.)
+pub const IMPLICIT_FROM: u32 = PROJECTED_SUBSTEPS_FROM;
 
 /// Steps one strand by `ctx.dt`. `strand_index` is the strand's index in the whole scene (as
 /// in [`Grab::strand`]); `accelerations` (if any) are the caller's per-node accelerations for
@@ -259,10 +287,13 @@ fn forces_and_integrate<M: Math, const N: usize>(
     report: &mut StepReport,
 ) -> [[Real; 2]; N] {
     let elastic = terms.bending || terms.twist;
+    let fixed = substeps(&strand.rest.rod, ctx.dt, terms.bending);
+    if terms.bending && fixed >= IMPLICIT_FROM {
+        return implicit_step::<M, N>(strand, ctx, clamped, terms, accelerations, report);
+    }
     // The frames of the shape the step starts from: they set the substep count and serve the
     // first substep's forces.
     let mut frames = elastic.then(|| strand_frames::<M, N>(strand));
-    let fixed = substeps(&strand.rest.rod, ctx.dt, terms.bending);
     let k = match &frames {
         // Converge mode adapts to a fold sharper than the allowance; fixed cost never does.
         Some(frames) if terms.bending && ctx.params.mode == Mode::Converge => {
@@ -321,6 +352,101 @@ fn forces_and_integrate<M: Math, const N: usize>(
         }
     }
     cos_sin
+}
+
+/// Stages (1) and (2) with bending on, as one linearly implicit step of `dt`
+/// ([`super::implicit`]): the elastic forces of Kmoch Sec. 7.2 at the current `θ`, the
+/// external forces as in [`external_forces_and_integrate`], then
+/// `(M + dt² H̃) v⁺ = M (v + dt a)` and `x⁺ = x + dt v⁺`. Returns `(cos θ^j, sin θ^j)`.
+///
+/// Not inlined: inlined into [`forces_and_integrate`] it made the substep path of human hair
+/// 2.4 % dearer on the Cortex-M4F (QEMU, 128 nodes), 1.2 % with it kept apart.
+#[inline(never)]
+fn implicit_step<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    clamped: &ClampedSegments,
+    terms: ElasticTerms,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) -> [[Real; 2]; N] {
+    report.ran(Stage::ElasticForces);
+    report.ran(Stage::ExternalForces);
+    report.ran(Stage::Integrate);
+    let h = ctx.dt;
+    let n = strand.rest.nodes.min(N);
+    let segments = n.saturating_sub(1);
+    let cos_sin = material_angles::<M, N>(&strand.state.theta[..segments]);
+    let frames = strand_frames::<M, N>(strand);
+    let mut forces = [Vec3::ZERO; N];
+    elastic_forces_with_angles(
+        &frames,
+        &strand.state.theta,
+        &cos_sin,
+        &strand.rest.rod,
+        clamped,
+        terms,
+        &mut forces,
+    );
+    let mut system = BendingSystem::<N>::default();
+    system.assemble(&frames, &strand.rest.mass, &strand.rest.rod, h);
+    system.factor();
+    let drag = drag(ctx);
+    // Right-hand side M (v + h a), with a as in the explicit step.
+    let mut rhs = [[0.0; 3]; N];
+    let state = &mut strand.state;
+    let rest = &strand.rest;
+    let nodes = rhs
+        .iter_mut()
+        .zip(&state.velocity)
+        .zip(forces.iter().zip(rest.mass.iter().zip(&rest.inverse_mass)))
+        .enumerate()
+        .take(n)
+        .skip(2);
+    for (i, ((slot, v), (force, (mass, inverse_mass)))) in nodes {
+        let a = acceleration(ctx, *force, *v, drag, *inverse_mass, accelerations, i);
+        *slot = ((*v + a * h) * *mass).to_array();
+    }
+    let held_velocity = [0, 1].map(|i| held_node(ctx, rest.position[i], state.position[i]).1);
+    BendingSystem::move_held_nodes(&frames, &rest.rod, h, held_velocity, &mut rhs);
+    system.solve(&mut rhs);
+    let nodes = rhs
+        .iter()
+        .zip(state.velocity.iter_mut().zip(state.position.iter_mut()))
+        .take(n)
+        .skip(2);
+    for (solved, (v, x)) in nodes {
+        *v = Vec3::from_array(*solved);
+        *x += *v * h;
+    }
+    cos_sin
+}
+
+/// The air drag coefficient `ν`, or zero with the `drag` effect off.
+fn drag(ctx: &StepContext) -> Real {
+    if ctx.has(Effect::Drag) {
+        ctx.params.drag
+    } else {
+        0.0
+    }
+}
+
+/// Node `i`'s acceleration `g + wind + (F − ν v)/m` plus the caller's.
+#[inline(always)]
+fn acceleration(
+    ctx: &StepContext,
+    force: Vec3,
+    v: Vec3,
+    drag: Real,
+    inverse_mass: Real,
+    accelerations: Option<&[Vec3]>,
+    i: usize,
+) -> Vec3 {
+    let mut a = ctx.gravity + ctx.wind + (force - v * drag) * inverse_mass;
+    if let Some(extra) = accelerations.and_then(|acc| acc.get(i)) {
+        a += *extra;
+    }
+    a
 }
 
 /// Fewest substeps at which the segment lengths are also projected between substeps

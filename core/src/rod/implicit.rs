@@ -1,0 +1,511 @@
+//! Linearly implicit bending: one elastic step per time step at any bending stiffness the
+//! validator accepts, with a banded solve per strand in fixed storage. A strand takes it when
+//! it would need [`IMPLICIT_FROM`](super::step::IMPLICIT_FROM) or more explicit substeps
+//! (stiffer than human hair, tight curls; `rod::step` says why not below).
+//!
+//! Symplectic Euler on the bending forces is only stable for `dt ≤ dt_max`
+//! ([`RodRest::stable_time_step`](super::energy::RodRest)); human hair at 1 cm and 1 ms sits
+//! near that limit and ×1000 stiffer hair 20× past it. Linearised backward Euler on the
+//! velocities (Baraff & Witkin 1998, eq. 6, written for the new velocity):
+//!
+//! `(M + h² H̃) v⁺ = M v + h (F(x) + F_ext)`, then `x⁺ = x + h v⁺`,
+//!
+//! with `F` the exact elastic forces of Kmoch Sec. 7.2 (the same ones the finite-difference
+//! tests check) and `H̃` a positive semi-definite approximation of the bending Hessian: the
+//! Gauss–Newton matrix of `E_bend` with the material frames held and `B^j` bounded by its
+//! largest entry,
+//!
+//! `H̃ = Σ_i (2 b_i / l̂_i) J_iᵀ J_i + Σ_i D_i ∇ψ_i∇ψ_iᵀ + Σ_j k (t^j t^jᵀ on e^j)`,
+//! `J_i = ∂(κb)_i / ∂(x_{i−1}, x_i, x_{i+1})`, `b_i = max(1, µ) max(α^{i−1}, α^i)`:
+//! bending, a bound on the holonomy part ([`HOLONOMY_SHARE`], `holonomy_weights`) and an
+//! axial term that stands for inextensibility in the solve ([`AXIAL_PENALTY`]).
+//!
+//! For a straight strand at rest with `µ = 1` it is the exact Hessian (the test below checks
+//! it against finite differences of the forces); elsewhere it leaves out the terms weighted
+//! by `ω − ω̂` and the holonomy. Why it is stable: for a mode of true stiffness `λ` and
+//! approximate stiffness `λ̃` the scheme's amplification matrix has determinant
+//! `1/(1 + h²λ̃) < 1` and stays stable while `h²λ ≤ 4 + 2h²λ̃`, so `H̃` may miss up to half of a
+//! stiff mode's true stiffness; `(κb)_i ∝ 1/d_i` puts the stiffening of a sharp bend into
+//! `J_i`, so no fold allowance is needed. What it costs: the modes with `h²λ̃ ≫ 1` (only the
+//! stiffest bending modes of the discrete strand, the ones a saw-tooth would live in) lose
+//! energy each step; slow motion (a swing, a sag) is untouched (`h²λ̃ ≈ 1e-5` there) and a
+//! static equilibrium (`F = 0`) is exactly that of the explicit forces.
+//!
+//! Structure: `J_i` couples three consecutive nodes, so `H̃` is block-pentadiagonal in the
+//! nodes, a band of half-width [`BAND`] = 8 in the `3n` scalar unknowns. Nodes 0 and 1 belong
+//! to the head and stay put during this stage (as in the explicit step); they are left out of
+//! the system. The band is factored as `L D Lᵀ` (no square roots; one division per row) and
+//! solved in O(n), in storage sized by `N`.
+
+use super::energy::{RodFrames, RodRest};
+use crate::math::{Math, Real, Vec3};
+
+/// Half-bandwidth of `M + h² H̃` in scalar unknowns: node `i`'s row reaches node `i − 2`'s
+/// last axis, `3·2 + 2`.
+pub const BAND: usize = 8;
+
+/// One scalar row of the band: `[A(r, r), A(r, r − 1), …, A(r, r − BAND)]`.
+type BandRow = [Real; BAND + 1];
+
+/// `M + h² H̃` for one strand (lower band, rows node-major then axis), factored in place.
+#[derive(Clone, Debug)]
+pub struct BendingSystem<const N: usize> {
+    band: [[BandRow; 3]; N],
+    inverse_pivot: [[Real; 3]; N],
+    nodes: usize,
+}
+
+impl<const N: usize> Default for BendingSystem<N> {
+    fn default() -> Self {
+        BendingSystem {
+            band: [[[0.0; BAND + 1]; 3]; N],
+            inverse_pivot: [[0.0; 3]; N],
+            nodes: 0,
+        }
+    }
+}
+
+/// First unknown row: nodes 0 and 1 are held by the head.
+const FIRST_ROW: usize = 6;
+
+/// `e × x̂`, `e × ŷ`, `e × ẑ`: the columns of `v ↦ e × v`.
+#[inline(always)]
+fn cross_columns(e: Vec3) -> [Vec3; 3] {
+    [
+        Vec3::new(0.0, e.z, -e.y),
+        Vec3::new(-e.z, 0.0, e.x),
+        Vec3::new(e.y, -e.x, 0.0),
+    ]
+}
+
+/// The columns of `∂(κb)/∂e^{i−1}` and `∂(κb)/∂e^i` for `(κb) = 2 e^{i−1}×e^i / d`,
+/// `d = |ê^{i−1}||ê^i| + e^{i−1}·e^i`: `A = (−2[e^i]× − κb e^{iᵀ}) / d`,
+/// `C = (2[e^{i−1}]× − κb e^{i−1ᵀ}) / d` with `[e]× v = e × v`, column `b` of each.
+#[inline(always)]
+fn binormal_jacobians(e_prev: Vec3, e_next: Vec3, kb: Vec3, d: Real) -> ([Vec3; 3], [Vec3; 3]) {
+    let inv_d = 1.0 / d;
+    let two_inv_d = 2.0 * inv_d;
+    let kb_d = kb * inv_d;
+    let n = cross_columns(e_next);
+    let p = cross_columns(e_prev);
+    let en = [e_next.x, e_next.y, e_next.z];
+    let ep = [e_prev.x, e_prev.y, e_prev.z];
+    let a = [
+        -(n[0] * two_inv_d) - kb_d * en[0],
+        -(n[1] * two_inv_d) - kb_d * en[1],
+        -(n[2] * two_inv_d) - kb_d * en[2],
+    ];
+    let c = [
+        p[0] * two_inv_d - kb_d * ep[0],
+        p[1] * two_inv_d - kb_d * ep[1],
+        p[2] * two_inv_d - kb_d * ep[2],
+    ];
+    (a, c)
+}
+
+/// `XᵀY` for matrices given by columns: `[p][q] = x_p · y_q`.
+#[inline(always)]
+fn gram(x: &[Vec3; 3], y: &[Vec3; 3]) -> [[Real; 3]; 3] {
+    let mut g = [[0.0; 3]; 3];
+    for (row, xp) in g.iter_mut().zip(x) {
+        for (slot, yq) in row.iter_mut().zip(y) {
+            *slot = xp.dot(*yq);
+        }
+    }
+    g
+}
+
+/// `h² · 2 b_i / l̂_i`: the weight of node `i`'s term, both frames' bending terms bounded by
+/// `b_i = max(1, µ) max(α^{i−1}, α^i)`.
+#[inline(always)]
+fn node_weight<const N: usize>(rest: &RodRest<N>, i: usize, h: Real) -> Real {
+    let penalty = rest.minor_axis_penalty.max(1.0);
+    let alpha = rest.bending_stiffness[i - 1].max(rest.bending_stiffness[i]);
+    h * h * 2.0 * penalty * alpha * rest.inverse_voronoi_length[i]
+}
+
+/// `J_i = ∂(κb)_i/∂(x_{i−1}, x_i, x_{i+1}) = (−A, A − C, C)` from `frames`
+/// ([`binormal_jacobians`]), by columns per node.
+#[inline(always)]
+fn node_jacobian<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize) -> [[Vec3; 3]; 3] {
+    let (a, c) = binormal_jacobians(
+        frames.edge[i - 1],
+        frames.edge[i],
+        frames.curvature_binormal[i],
+        frames.denominator[i],
+    );
+    [
+        [-a[0], -a[1], -a[2]],
+        [a[0] - c[0], a[1] - c[1], a[2] - c[2]],
+        c,
+    ]
+}
+
+/// `h² k` of the axial term on each free segment, in units of the segment's mean node mass.
+///
+/// Why: the strand is inextensible, but only the projection after this stage says so. A
+/// curved strand's bending forces have components along its segments; left free in the
+/// velocity solve they stretch it within the step, the projection snaps it back with
+/// `v += Δx/h`, and the pair pumps energy: a 2 mm curl (40 nodes, 2 mm segments) reached
+/// 4–7 m/s within 20 steps on a still head and blew up. A stiff axial spring `k (t tᵀ)` on
+/// each segment *in the matrix only* (no force goes with it) makes the solve keep segment
+/// lengths to first order; it removes only the stretching part of the velocity, which the
+/// projection removes anyway (`1/(1 + 1000)` of it is left), so it adds no damping on the
+/// constraint manifold. (The explicit substeps did the same job with a projection between
+/// substeps.)
+pub const AXIAL_PENALTY: Real = 1.0e3;
+
+/// The share of the Gershgorin bound of the holonomy part taken into `H̃`
+/// (`holonomy_weights`).
+///
+/// Why not all of it: with 1 (a bound on the whole part, and in the linear analysis of the
+/// elastic step alone stable on a 2 mm curl) a 40-node 2 mm curl on a shaking head grew a slow
+/// mode by 3 % per step from step ~250 and burst at step ~300 with the hair-optimised twist
+/// (with Newton it stayed calm for 2000 steps; with 2 it burst at step ~170, with 0.5 it
+/// stays calm): the hair-optimised twist is not an energy minimiser, so the elastic forces
+/// are not conservative along its θ(x), and the extra damping of the implicit step drives a
+/// slow mode of such a system (damping can destabilise a non-conservative system; Ziegler's
+/// paradox). With 0.5 the elastic step's linear analysis needs `H̃` × 1.25 on that curl at
+/// rest (the test states it) and the whole step — projection included — is stable in every
+/// test. A measured compromise, not a bound.
+pub const HOLONOMY_SHARE: Real = 0.5;
+
+/// `∇ψ_i` on `(x_{i−1}, x_i, x_{i+1})`, the holonomy gradient of the force code:
+/// `(κ̃b/(2|e^{i−1}|), −(first + last), −κ̃b/(2|e^i|))`, `κ̃b = 2 t^{i−1}×t^i/(1 + t^{i−1}·t^i)`.
+#[inline(always)]
+fn holonomy_gradient<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize) -> [Vec3; 3] {
+    let (t_prev, t_next) = (frames.tangent[i - 1], frames.tangent[i]);
+    let kb_unit = t_prev.cross(t_next) * (2.0 / (1.0 + t_prev.dot(t_next)));
+    let first = kb_unit * (0.5 * frames.inverse_length[i - 1]);
+    let last = -(kb_unit * (0.5 * frames.inverse_length[i]));
+    [first, -(first + last), last]
+}
+
+/// `h² D_i`: the weights of `∇ψ_i ∇ψ_iᵀ` that bound the stiffness the holonomy gives the
+/// elastic forces at fixed `θ`.
+///
+/// Why: with `θ` held over the step, moving a node turns every material frame downstream by
+/// `δΨ^j = Σ_{k≤j} δψ_k` about its tangent, and `ω^j_i` changes by `−(κ1, κ2) δΨ^j` (the
+/// frames' turn with their tangents does not change `ω`: `κb ⊥ t`). The Gauss–Newton Hessian
+/// of that part is `Σ_j c_j ∇Ψ^jᵀ∇Ψ^j`, `c_j = Σ_{i∈{j,j+1}} b_i |κb_i|² / l̂_i`: a dense
+/// matrix `S_kl = C_{max(k,l)}` (suffix sums `C_k = Σ_{j≥k} c_j`) in the `ψ_k`. On a tight
+/// curl it is what makes the step stable (2 mm helix: without it the rest state needs the
+/// matrix ×4 to be stable, see the tests). `S` has positive entries, so its row sums bound it
+/// (Gershgorin: `diag(Σ_l S_kl) − S` is diagonally dominant): `D_k = k C_k + Σ_{l>k} C_l`,
+/// which keeps the band. The cross terms between `J` and this part are bounded by taking
+/// both at full weight (`(a + b)² ≤ 2a² + 2b²`, and the stability bound allows a factor 2).
+fn holonomy_weights<M: Math, const N: usize>(
+    frames: &RodFrames<M, N>,
+    rest: &RodRest<N>,
+    h: Real,
+) -> [Real; N] {
+    let n = frames.interior().min(N.saturating_sub(2));
+    let mut q = [0.0; N];
+    for (i, (slot, kb)) in q
+        .iter_mut()
+        .zip(&frames.curvature_binormal)
+        .enumerate()
+        .take(n + 1)
+        .skip(1)
+    {
+        *slot = node_weight(rest, i, 1.0) * 0.5 * kb.dot(*kb);
+    }
+    let mut weights = [0.0; N];
+    // Frames j = 1 … n; c_j = q_j + q_{j+1}; C_k and Σ_{l>k} C_l from the tip.
+    let mut suffix = 0.0;
+    let mut beyond = 0.0;
+    for k in (1..=n).rev() {
+        let next = if k < n { q[k + 1] } else { 0.0 };
+        suffix += q[k] + next;
+        weights[k] = HOLONOMY_SHARE * h * h * (k as Real * suffix + beyond);
+        beyond += suffix;
+    }
+    weights
+}
+
+/// The six blocks `(a, b)`, `b ≤ a`, of node `i`'s terms on its triple
+/// `(x_{i−1}, x_i, x_{i+1})`, in the order `(0,0), (1,0), (1,1), (2,0), (2,1), (2,2)`: bending
+/// `s J_aᵀJ_b`, holonomy `d ∇_aψ_i ∇_bψ_iᵀ`, and the axial term of segment `i` (nodes `i`,
+/// `i + 1`). `block[p][q]` is row axis `p`, column axis `q`.
+#[inline(always)]
+fn node_blocks<M: Math, const N: usize>(
+    frames: &RodFrames<M, N>,
+    mass: &[Real; N],
+    rest: &RodRest<N>,
+    i: usize,
+    h: Real,
+    holonomy: Real,
+) -> [[[Real; 3]; 3]; 6] {
+    let s = node_weight(rest, i, h);
+    let (a, c) = binormal_jacobians(
+        frames.edge[i - 1],
+        frames.edge[i],
+        frames.curvature_binormal[i],
+        frames.denominator[i],
+    );
+    let aa = gram(&a, &a);
+    let cc = gram(&c, &c);
+    let ac = gram(&a, &c);
+    // ∇ψ_i = γ_k κ̃b on the triple (holonomy_gradient).
+    let (t_prev, t_next) = (frames.tangent[i - 1], frames.tangent[i]);
+    let kb_unit = t_prev.cross(t_next) * (2.0 / (1.0 + t_prev.dot(t_next)));
+    let first = 0.5 * frames.inverse_length[i - 1];
+    let last = -0.5 * frames.inverse_length[i];
+    let middle = -(first + last);
+    let kk = outer(kb_unit);
+    // Axial term of segment i (nodes i, i + 1).
+    let axial = AXIAL_PENALTY * 0.5 * (mass[i] + mass[i + 1]);
+    let tt = outer(t_next);
+    let hol = [
+        holonomy * first * first,
+        holonomy * middle * first,
+        holonomy * middle * middle,
+        holonomy * last * first,
+        holonomy * last * middle,
+        holonomy * last * last,
+    ];
+    let mut blocks = [[[0.0; 3]; 3]; 6];
+    for p in 0..3 {
+        for q in 0..3 {
+            // J = (−A, A − C, C): J_aᵀJ_b from AᵀA, CᵀC, AᵀC (ac[q][p] = c_p·a_q).
+            let (aa, cc, ac, ca) = (aa[p][q], cc[p][q], ac[p][q], ac[q][p]);
+            let (kk, tt) = (kk[p][q], tt[p][q]);
+            blocks[0][p][q] = s * aa + hol[0] * kk;
+            blocks[1][p][q] = s * (ca - aa) + hol[1] * kk;
+            blocks[2][p][q] = s * (aa - ac - ca + cc) + hol[2] * kk + axial * tt;
+            blocks[3][p][q] = -(s * ca) + hol[3] * kk;
+            blocks[4][p][q] = s * (ca - cc) + hol[4] * kk - axial * tt;
+            blocks[5][p][q] = s * cc + hol[5] * kk + axial * tt;
+        }
+    }
+    blocks
+}
+
+/// `u uᵀ`.
+#[inline(always)]
+fn outer(u: Vec3) -> [[Real; 3]; 3] {
+    let [x, y, z] = u.to_array();
+    [
+        [x * x, x * y, x * z],
+        [y * x, y * y, y * z],
+        [z * x, z * y, z * z],
+    ]
+}
+
+/// Adds `block` to the rows `rows` of one node at column node `OFFSET` nodes back (lower
+/// triangle only on the diagonal block). Constant offsets: no run-time index checks.
+#[inline(always)]
+fn add_block<const OFFSET: usize>(rows: &mut [BandRow; 3], block: &[[Real; 3]; 3]) {
+    for (p, row) in rows.iter_mut().enumerate() {
+        for (q, value) in block[p].iter().enumerate() {
+            if OFFSET == 0 && q > p {
+                continue;
+            }
+            row[3 * OFFSET + p - q] += *value;
+        }
+    }
+}
+
+/// One row `r ≥ BAND` of the `L D Lᵀ` factorisation: `previous[k]` is the factored row
+/// `r − BAND + k`, `inverse_pivot[k]` its `1/D`. Returns `1/D(r)`.
+#[inline(always)]
+fn factor_row(row: &mut BandRow, previous: &[BandRow; BAND], inverse_pivot: &[Real; BAND]) -> Real {
+    // ld[m] = L(r, r − m) D(r − m), filled from the farthest column in. (Exclusive ranges:
+    // `a..=b` iterates with an extra check per step.)
+    let mut ld = [0.0; BAND + 1];
+    for m in (1..BAND + 1).rev() {
+        let column = &previous[BAND - m];
+        let mut sum = row[m];
+        for q in m + 1..BAND + 1 {
+            sum -= ld[q] * column[q - m];
+        }
+        ld[m] = sum;
+        row[m] = sum * inverse_pivot[BAND - m];
+    }
+    let mut pivot = row[0];
+    for m in 1..BAND + 1 {
+        pivot -= row[m] * ld[m];
+    }
+    row[0] = pivot;
+    1.0 / pivot
+}
+
+impl<const N: usize> BendingSystem<N> {
+    /// Assembles `M + h² H̃` for the strand of `frames` (see the module documentation) with
+    /// node masses `mass`, the stiffnesses of `rest` and the step `h`.
+    pub fn assemble<M: Math>(
+        &mut self,
+        frames: &RodFrames<M, N>,
+        mass: &[Real; N],
+        rest: &RodRest<N>,
+        h: Real,
+    ) {
+        let nodes = frames.nodes.min(N);
+        self.nodes = nodes;
+        for (i, rows) in self.band.iter_mut().enumerate().take(nodes) {
+            let diagonal = if i >= 2 { mass[i] } else { 1.0 };
+            let mut row = [0.0; BAND + 1];
+            row[0] = diagonal;
+            *rows = [row; 3];
+        }
+        let holonomy = holonomy_weights(frames, rest, h);
+        for (i, weight) in holonomy
+            .iter()
+            .enumerate()
+            .take(nodes.saturating_sub(1))
+            .skip(1)
+        {
+            let blocks = node_blocks(frames, mass, rest, i, h, *weight);
+            let [b00, b10, b11, b20, b21, b22] = &blocks;
+            // Rows and columns of the held nodes 0 and 1 are not unknowns.
+            if i >= 3 {
+                if let Some(rows) = self.band.get_mut(i - 1) {
+                    add_block::<0>(rows, b00);
+                }
+            }
+            if i >= 2 {
+                if let Some(rows) = self.band.get_mut(i) {
+                    if i >= 3 {
+                        add_block::<1>(rows, b10);
+                    }
+                    add_block::<0>(rows, b11);
+                }
+            }
+            if let Some(rows) = self.band.get_mut(i + 1) {
+                if i >= 3 {
+                    add_block::<2>(rows, b20);
+                }
+                if i >= 2 {
+                    add_block::<1>(rows, b21);
+                }
+                add_block::<0>(rows, b22);
+            }
+        }
+    }
+
+    /// Moves the held nodes' part of `h² H̃ v⁺` to the right-hand side: nodes 0 and 1 move
+    /// with `held_velocity` (the head's motion over the step, which the root coupling gives
+    /// them), so a stiff strand turns with the head within the step instead of lagging a step
+    /// behind it. Subtracts `h² H̃_{free,held} v_held` from `rhs`.
+    pub fn move_held_nodes<M: Math>(
+        frames: &RodFrames<M, N>,
+        rest: &RodRest<N>,
+        h: Real,
+        held_velocity: [Vec3; 2],
+        rhs: &mut [[Real; 3]; N],
+    ) {
+        let nodes = frames.nodes.min(N);
+        let holonomy = holonomy_weights(frames, rest, h);
+        // Interior nodes 1 and 2 are the only terms that reach a held node.
+        let reach = nodes.saturating_sub(1).min(3);
+        for (i, d) in holonomy.iter().copied().enumerate().take(reach).skip(1) {
+            let s = node_weight(rest, i, h);
+            let j = node_jacobian(frames, i);
+            let g = holonomy_gradient(frames, i);
+            let apply = |m: &[Vec3; 3], v: Vec3| m[0] * v.x + m[1] * v.y + m[2] * v.z;
+            // s J' v_held over the held nodes of the triple (i − 1 + k < 2).
+            let mut jv = Vec3::ZERO;
+            for (k, jk) in j.iter().enumerate() {
+                if let Some(v) = held_velocity.get(i - 1 + k) {
+                    jv += apply(jk, *v);
+                }
+            }
+            let mut gv = 0.0;
+            for (k, gk) in g.iter().enumerate() {
+                if let Some(v) = held_velocity.get(i - 1 + k) {
+                    gv += gk.dot(*v);
+                }
+            }
+            let (jv, gv) = (jv * s, gv * d);
+            for (k, (jk, gk)) in j.iter().zip(&g).enumerate() {
+                let node = i - 1 + k;
+                if node < 2 {
+                    continue;
+                }
+                if let Some(row) = rhs.get_mut(node) {
+                    let gk = gk.to_array();
+                    for ((slot, column), gkp) in row.iter_mut().zip(jk).zip(gk) {
+                        *slot -= column.dot(jv) + gkp * gv;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Factors the band as `L D Lᵀ` in place (`L` strictly below the diagonal with unit
+    /// diagonal, `D` on the diagonal) over the unknown rows. The held nodes' rows stay the
+    /// identity, with nothing coupling to them, so that full windows of [`BAND`] rows can
+    /// reach into them.
+    pub fn factor(&mut self) {
+        let band = self.band.as_flattened_mut();
+        let inverse_pivot = self.inverse_pivot.as_flattened_mut();
+        let rows = (3 * self.nodes).min(band.len()).min(inverse_pivot.len());
+        for slot in inverse_pivot.iter_mut().take(FIRST_ROW) {
+            *slot = 1.0;
+        }
+        for r in FIRST_ROW..rows {
+            let (done, rest) = band.split_at_mut(r);
+            let (pivots_done, pivots_rest) = inverse_pivot.split_at_mut(r);
+            let (Some(row), Some(pivot)) = (rest.first_mut(), pivots_rest.first_mut()) else {
+                break;
+            };
+            let start = r.saturating_sub(BAND);
+            let windows = (
+                <&[BandRow; BAND]>::try_from(&done[start..]),
+                <&[Real; BAND]>::try_from(&pivots_done[start..]),
+            );
+            *pivot = match windows {
+                (Ok(previous), Ok(pivots)) => factor_row(row, previous, pivots),
+                // The first rows (r < BAND): the same with a shorter reach.
+                _ => {
+                    let mut previous = [[0.0; BAND + 1]; BAND];
+                    let mut pivots = [1.0; BAND];
+                    let reach = r - start;
+                    for k in 0..reach {
+                        previous[BAND - reach + k] = done[start + k];
+                        pivots[BAND - reach + k] = pivots_done[start + k];
+                    }
+                    factor_row(row, &previous, &pivots)
+                }
+            };
+        }
+    }
+
+    /// Solves `L D Lᵀ z = rhs` in place after [`Self::factor`]; the held nodes' entries are
+    /// left as they are (zero in the step).
+    pub fn solve(&self, rhs: &mut [[Real; 3]; N]) {
+        let band = self.band.as_flattened();
+        let inverse_pivot = self.inverse_pivot.as_flattened();
+        let z = rhs.as_flattened_mut();
+        let rows = (3 * self.nodes).min(band.len()).min(z.len());
+        // L y = rhs: z[r] −= Σ_m L(r, r − m) z[r − m].
+        for r in FIRST_ROW..rows {
+            let row = &band[r];
+            let start = r.saturating_sub(BAND);
+            let mut sum = z[r];
+            for (l, previous) in row[1..].iter().zip(z[start..r].iter().rev()) {
+                sum -= *l * *previous;
+            }
+            z[r] = sum;
+        }
+        for (value, inverse) in z.iter_mut().zip(inverse_pivot).take(rows).skip(FIRST_ROW) {
+            *value *= *inverse;
+        }
+        // Lᵀ x = y: z[r] −= Σ_m L(r + m, r) z[r + m].
+        for r in (FIRST_ROW..rows).rev() {
+            let end = rows.min(r + BAND + 1);
+            let (head, tail) = z.split_at_mut(r + 1);
+            let (Some(value), Some(below)) = (head.last_mut(), band.get(r + 1..end)) else {
+                continue;
+            };
+            let mut sum = *value;
+            for (m, (row, solved)) in below.iter().zip(tail.iter()).enumerate() {
+                sum -= row[m + 1] * *solved;
+            }
+            *value = sum;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
