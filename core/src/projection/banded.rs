@@ -123,7 +123,7 @@ pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u
                 continue;
             }
             if let Some(row) = rows.rows.get_mut(usize::from(r)) {
-                let g = row.gradient[block];
+                let g = row.gradient_at(block);
                 row.rhs -= g.dot(contacts.displacement);
                 let along = if single {
                     g0 * (inv00 * g0.dot(g))
@@ -143,7 +143,7 @@ pub fn undo_elimination<const N: usize>(rows: &mut Rows<N>) {
     let count = rows.count.min(N);
     for row in rows.rows.iter_mut().take(count) {
         row.rhs = row.value;
-        row.projected = row.gradient;
+        row.projected = row.gradients();
     }
 }
 

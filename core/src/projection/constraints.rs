@@ -32,9 +32,12 @@ pub const MAX_NODE_CONTACTS: usize = 2;
 /// "No row" in [`Rows::segment_row`].
 pub const NO_ROW: u16 = u16::MAX;
 
-/// What a row constrains.
+/// What a row constrains. Four bytes wide, so that a [`Row`] has no padding and an array of
+/// default rows is one zero fill (with a one-byte tag the Cortex-M4F build cleared each row
+/// with a call of its own, around the padding).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u32)]
 pub enum RowKind {
     /// A placeholder that keeps the layout fixed (fixed-cost mode): `A_rr = 1`, `C = 0`.
     #[default]
@@ -43,8 +46,9 @@ pub enum RowKind {
     Segment,
 }
 
-/// One segment row: its value and gradient (two 3-blocks), and the same after the collision
-/// rows of its nodes were eliminated.
+/// One segment row: its value and gradient, and the gradient's two 3-blocks after the collision
+/// rows of its nodes were eliminated. The gradient is stored once: its blocks are `∓2e`
+/// (see [`Row::gradient_at`]), and negation is exact, so nothing changes but the size.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Row {
     /// `C(x_k)`.
@@ -53,8 +57,8 @@ pub struct Row {
     pub rhs: Real,
     /// The two nodes of the segment.
     pub nodes: [u16; 2],
-    /// `∇_{x_{nodes[0]}} C` and `∇_{x_{nodes[1]}} C`.
-    pub gradient: [Vec3; 2],
+    /// `∇_{x_{nodes[1]}} C = 2e`; `∇_{x_{nodes[0]}} C` is its negation.
+    pub gradient: Vec3,
     /// The gradient blocks with each node's contact normals projected out, `(I − P_i)∇C`
     /// (equal to `gradient` at a node without contact).
     pub projected: [Vec3; 2],
@@ -68,15 +72,34 @@ impl Row {
     pub fn segment(j: usize, x_j: Vec3, x_next: Vec3, rest_length: Real) -> Row {
         let e = x_next - x_j;
         let value = e.dot(e) - rest_length * rest_length;
-        let gradient = [e * -2.0, e * 2.0];
+        let gradient = e * 2.0;
         Row {
             value,
             rhs: value,
             nodes: [j as u16, (j + 1) as u16],
             gradient,
-            projected: gradient,
+            projected: [-gradient, gradient],
             kind: RowKind::Segment,
         }
+    }
+
+    /// `∇_{x_{nodes[block]}} C`: `−2e` for block 0, `2e` for block 1 (bit for bit what
+    /// `e * -2.0` gives).
+    #[inline(always)]
+    #[must_use]
+    pub fn gradient_at(&self, block: usize) -> Vec3 {
+        if block == 0 {
+            -self.gradient
+        } else {
+            self.gradient
+        }
+    }
+
+    /// Both blocks of the gradient, `[∇_{x_{nodes[0]}} C, ∇_{x_{nodes[1]}} C]`.
+    #[inline(always)]
+    #[must_use]
+    pub fn gradients(&self) -> [Vec3; 2] {
+        [-self.gradient, self.gradient]
     }
 }
 
@@ -99,10 +122,14 @@ pub fn contact(shape: &Shape, normal: Vec3, depth: Real) -> (Real, Vec3) {
 }
 
 /// The collision rows of one node, and what eliminating them leaves for the segments.
+///
+/// The small fields are `u16` (with the two `u8` colliders: eight bytes) so that the struct
+/// has no padding: an array of defaults is then one zero fill, where padding made the
+/// Cortex-M4F build clear each node's entry with a call of its own.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NodeContacts {
     /// Rows in use (≤ [`MAX_NODE_CONTACTS`]).
-    pub count: u8,
+    pub count: u16,
     /// The collider of each row (its index in the step's list).
     pub collider: [u8; MAX_NODE_CONTACTS],
     /// `C` of each row.
@@ -110,14 +137,14 @@ pub struct NodeContacts {
     /// `∇_{x_i}C` of each row.
     pub gradient: [Vec3; MAX_NODE_CONTACTS],
     /// Rows kept by the elimination (a row whose gradient depends on the first is dropped).
-    pub kept: u8,
+    pub kept: u16,
     /// `(GᵀG)⁻¹` of the kept gradients `G`, as `[a₀₀, a₀₁, a₁₁]`.
     pub inverse_gram: [Real; 3],
     /// `d = G (GᵀG)⁻¹ C`: minus the smallest move that meets the linearised contacts.
     pub displacement: Vec3,
     /// Bit `k`: row `k` is *tentative* — its node is outside the collider, within
     /// [`CONTACT_MARGIN`] of it (see [`evaluate`]); it stays only if its multiplier pushes.
-    pub tentative: u8,
+    pub tentative: u16,
 }
 
 impl NodeContacts {
@@ -150,7 +177,7 @@ impl NodeContacts {
 impl NodeContacts {
     /// Removes the rows whose bit is set in `mask` (those after them move up): tentative
     /// rows whose multiplier turned out to pull.
-    pub fn remove(&mut self, mask: u8) {
+    pub fn remove(&mut self, mask: u16) {
         let mut kept = NodeContacts::default();
         let count = usize::from(self.count).min(MAX_NODE_CONTACTS);
         for k in 0..count {
@@ -237,6 +264,9 @@ pub struct Rows<const N: usize> {
 }
 
 impl<const N: usize> Default for Rows<N> {
+    // Inlined so that the arrays are filled in their final place (the projection's
+    // workspace), not built on the stack and copied there.
+    #[inline(always)]
     fn default() -> Self {
         Rows {
             rows: [Row::default(); N],
@@ -314,6 +344,7 @@ pub struct ContactMemory<const N: usize> {
 }
 
 impl<const N: usize> Default for ContactMemory<N> {
+    #[inline(always)]
     fn default() -> Self {
         ContactMemory {
             touched: [0; N],

@@ -189,6 +189,9 @@ fn keep_finite<const N: usize>(
 }
 
 impl<const N: usize> Workspace<N> {
+    // Inlined so that the workspace is filled where it lives, not built and copied (on the
+    // Cortex-M4F the copies were a fifth of the projection's zero fills and copies).
+    #[inline(always)]
     fn new(strand: &Strand<N>, n: usize) -> Self {
         let mut inverse_mass = [0.0; N];
         for (i, (w, &rest)) in inverse_mass
@@ -585,7 +588,7 @@ fn solve_and_move<M: Math, const N: usize>(
     // Forces from the multipliers actually applied (`scale · δλ`): only for held grabs.
     let grabbed = if held.is_empty() { &[] } else { rows };
     for (row, &lambda) in grabbed.iter().zip(multipliers.iter()) {
-        for (&node, &gradient) in row.nodes.iter().zip(row.gradient.iter()) {
+        for (&node, &gradient) in row.nodes.iter().zip(row.gradients().iter()) {
             let i = usize::from(node);
             if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
                 *pull -= gradient * (lambda * scale);
@@ -682,7 +685,7 @@ fn segment_pull_on_node<const N: usize>(rows: &Rows<N>, multipliers: &[Real], i:
             .get(segment)
             .map_or(usize::MAX, |&r| usize::from(r));
         if let (Some(row), Some(&lambda)) = (rows.rows.get(r), multipliers.get(r)) {
-            sum += row.gradient[block] * lambda;
+            sum += row.gradient_at(block) * lambda;
         }
     }
     sum
