@@ -2,29 +2,39 @@
 //! rough k-nearest list), with the density and pressure of each particle (line 7) taken in
 //! the same pass, while the distances are at hand.
 //!
-//! Particles of one cell are consecutive in the sorted order and share the ranges of the 27
-//! cells around them ([`Grid::ranges_around`], computed once per such run). For each particle
-//! the candidates of each range — contiguous in the sorted structure-of-arrays positions — are
-//! tested eight at a time for `r² < h²` (no square root), and the first `cap` that pass (and
-//! are not the particle itself nor its own strand's near nodes) are kept, in scan order. The
-//! order is a function of the positions only, so lists, truncation and every sum over a list
-//! are the same on any number of threads.
+//! Each particle's cell comes from its sorted position; the nine rows around it
+//! ([`RowsAround`]) are hashed once per run of particles in one row, and the 27 cells are read
+//! as nine ranges of three cells (more where the row crosses into the next brick) of the
+//! sorted structure-of-arrays positions. The candidates of each range are tested eight at a
+//! time for `r² < h²` (no square root), and the first `cap` that pass (and are not the
+//! particle itself nor its own strand's near nodes) are kept, in scan order. The order is a
+//! function of the positions only, so lists, truncation and every sum over a list are the
+//! same on any number of threads.
+//!
+//! Lists are stored compactly: a chunk of particles writes its lists one after another into
+//! its own part of the storage, so the few neighbours a particle has (about five on a head)
+//! take a few bytes, not a cache line and a half of room for `cap` of them.
 
 use rayon::prelude::*;
 
 use super::forces::{poly6_factor, SortedParticles};
-use super::grid::Grid;
+use super::grid::{cell_of, Grid, RowsAround};
 use super::{SphParams, CHUNK};
 
 /// Lanes of the distance test, and entries past the last particle in the position arrays.
 pub const PADDING: usize = 8;
 
+/// Bits of a particle's key holding its node index; the strand is above them.
+pub const NODE_BITS: u32 = 8;
+
 /// One list of at most `cap` neighbours per particle, in sorted indices.
 #[derive(Clone, Debug)]
 pub struct NeighbourLists {
     cap: usize,
-    /// `list[a · cap .. a · cap + count[a]]` are particle `a`'s neighbours.
+    /// Every list: chunk `c`'s lists one after another from `c · CHUNK · cap`.
     pub list: Vec<u32>,
+    /// Where each particle's list starts in `list`.
+    pub start: Vec<u32>,
     /// How many neighbours each particle kept.
     pub count: Vec<u32>,
 }
@@ -50,13 +60,6 @@ impl Found {
     }
 }
 
-/// What the search needs for one particle.
-struct Particle {
-    x: [f32; 3],
-    strand: u32,
-    node: u32,
-}
-
 impl NeighbourLists {
     /// Lists for `particles` particles of at most `cap` neighbours each.
     #[must_use]
@@ -64,6 +67,7 @@ impl NeighbourLists {
         NeighbourLists {
             cap,
             list: vec![0; particles * cap],
+            start: vec![0; particles],
             count: vec![0; particles],
         }
     }
@@ -72,11 +76,12 @@ impl NeighbourLists {
     #[inline]
     #[must_use]
     pub fn of(&self, a: usize) -> &[u32] {
-        &self.list[a * self.cap..a * self.cap + self.count[a] as usize]
+        let start = self.start[a] as usize;
+        &self.list[start..start + self.count[a] as usize]
     }
 
-    /// Rebuilds every list from the sorted particles, and writes each particle's density and
-    /// pressure (`p.density`, `p.pressure`) and its packed force inputs (`p.packed`).
+    /// Rebuilds every list from the sorted particles, and writes each particle's density
+    /// (`p.density`) and its packed force inputs (`p.packed`, with the pressure).
     pub fn build(&mut self, grid: &Grid, p: &mut SortedParticles, params: &SphParams) -> Found {
         let cap = self.cap;
         let n = p.mass.len();
@@ -85,61 +90,45 @@ impl NeighbourLists {
         let c6 = poly6_factor(h);
         let (stiffness, rest) = (params.stiffness, params.rest_density);
         let gap = params.same_strand_gap;
+        let (inverse_cell, row_mask) = (grid.inverse_cell(), grid.row_mask());
         let SortedParticles {
             x,
             y,
             z,
-            velocity,
+            record,
             mass,
-            strand,
-            node,
-            cell,
+            key,
             density,
-            pressure,
             packed,
             ..
         } = p;
-        let (x, y, z, mass, strand, node, cell, velocity) = (
-            &x[..],
-            &y[..],
-            &z[..],
-            &mass[..],
-            &strand[..],
-            &node[..],
-            &cell[..],
-            &velocity[..],
-        );
+        let (x, y, z, mass, key, record) =
+            (&x[..], &y[..], &z[..], &mass[..], &key[..], &record[..]);
         self.list[..n * cap]
             .par_chunks_mut(CHUNK * cap)
+            .zip(self.start[..n].par_chunks_mut(CHUNK))
             .zip(self.count[..n].par_chunks_mut(CHUNK))
             .zip(density.par_chunks_mut(CHUNK))
-            .zip(pressure.par_chunks_mut(CHUNK))
             .zip(packed.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(c, ((((list, count), density), pressure), packed))| {
+            .map(|(c, ((((list, start), count), density), packed))| {
                 let mut found = Found::default();
-                let mut ranges = ([(0u32, 0u32); 18], 0usize);
+                let mut rows = RowsAround::NONE;
+                let mut used = 0usize;
                 for k in 0..count.len() {
                     let a = c * CHUNK + k;
-                    // A new run of one cell: its ranges (the run shares them).
-                    if k == 0 || cell[a] != cell[a - 1] {
-                        ranges = grid.ranges_around(cell[a]);
-                    }
-                    let me = Particle {
-                        x: [x[a], y[a], z[a]],
-                        strand: strand[a],
-                        node: node[a],
-                    };
-                    let mine = &mut list[k * cap..(k + 1) * cap];
+                    let me = [x[a], y[a], z[a]];
+                    let cell = cell_of(me.into(), inverse_cell);
+                    rows.update(cell, row_mask);
+                    let my_key = key[a];
+                    let mine = &mut list[used..used + cap];
                     let mut kept = 0usize;
                     let mut all = 0u32;
                     // ρ / (315/(64π h⁹)): own mass, then the kept neighbours in list order.
                     let mut sum = mass[a] * h2 * h2 * h2;
-                    for &(s, e) in &ranges.0[..ranges.1] {
-                        scan(s as usize, e as usize, &me, h2, (x, y, z), |j, d2| {
-                            if j == a
-                                || (strand[j] == me.strand && node[j].abs_diff(me.node) <= gap)
-                            {
+                    rows.ranges(grid, cell, |s, e| {
+                        scan(s, e, me, h2, (x, y, z), |j, d2| {
+                            if j == a || near_on_strand(key[j], my_key, gap) {
                                 return;
                             }
                             all += 1;
@@ -150,22 +139,30 @@ impl NeighbourLists {
                                 sum += mass[j] * (w * w * w);
                             }
                         });
-                    }
+                    });
+                    start[k] = (c * CHUNK * cap + used) as u32;
                     count[k] = kept as u32;
+                    used += kept;
                     found.kept += kept as u64;
                     found.truncated += u64::from(all) - kept as u64;
                     found.max_found = found.max_found.max(all);
                     let rho = c6 * sum;
                     let pr = (stiffness * (rho - rest)).max(0.0);
                     density[k] = rho;
-                    pressure[k] = pr;
-                    let v = velocity[a];
-                    packed[k] = [me.x[0], me.x[1], me.x[2], mass[a] / rho, v.x, v.y, v.z, pr];
+                    let [vx, vy, vz] = record[a].velocity;
+                    packed[k] = [me[0], me[1], me[2], mass[a] / rho, vx, vy, vz, pr];
                 }
                 found
             })
             .reduce(Found::default, Found::merge)
     }
+}
+
+/// Whether keys `a` and `b` are nodes of one strand at most `gap` apart.
+#[inline(always)]
+fn near_on_strand(a: u32, b: u32, gap: u32) -> bool {
+    let node = (1 << NODE_BITS) - 1;
+    (a >> NODE_BITS) == (b >> NODE_BITS) && (a & node).abs_diff(b & node) <= gap
 }
 
 /// Calls `hit(j, r²)` for every sorted particle `j` in `s .. e` with `r² < h2`, in order. The
@@ -176,16 +173,13 @@ impl NeighbourLists {
 fn scan(
     s: usize,
     e: usize,
-    me: &Particle,
+    [xa, ya, za]: [f32; 3],
     h2: f32,
     (x, y, z): (&[f32], &[f32], &[f32]),
     mut hit: impl FnMut(usize, f32),
 ) {
-    let [xa, ya, za] = me.x;
-    let len = e - s;
-    let mut o = 0;
-    while o < len {
-        let at = s + o;
+    let mut at = s;
+    while at < e {
         let (Some(bx), Some(by), Some(bz)) = (
             x.get(at..at + PADDING),
             y.get(at..at + PADDING),
@@ -200,14 +194,14 @@ fn scan(
             d2[l] = dx * dx + dy * dy + dz * dz;
             mask |= u32::from(d2[l] < h2) << l;
         }
-        if len - o < PADDING {
-            mask &= (1 << (len - o)) - 1;
+        if e - at < PADDING {
+            mask &= (1 << (e - at)) - 1;
         }
         while mask != 0 {
             let l = mask.trailing_zeros() as usize;
             mask &= mask - 1;
             hit(at + l, d2[l]);
         }
-        o += PADDING;
+        at += PADDING;
     }
 }
