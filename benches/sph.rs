@@ -226,6 +226,14 @@ fn main() {
         }
         if filter.iter().any(|f| f.as_str() == "stage") {
             let repeats = if quick { 1 } else { STAGE_REPEATS };
+            // `warm-up=K` and `repeats=R` (for a run under a profiler or valgrind).
+            let number = |name: &str| {
+                filter
+                    .iter()
+                    .find_map(|f| f.strip_prefix(name)?.parse::<u64>().ok())
+            };
+            let warm_up = number("warm-up=").unwrap_or(warm_up);
+            let repeats = number("repeats=").map_or(repeats, |r| r as usize);
             match size.nodes {
                 0..=16 => stage::<16>(size, warm_up, repeats),
                 _ => stage::<32>(size, warm_up, repeats),

@@ -168,11 +168,11 @@ pub struct RowsAround {
     /// The cell's `(x div 16, y, z)` these rows are for.
     key: [i32; 3],
     /// Bucket offset of each row in the cell's brick along x.
-    pub own: [u32; 9],
-    /// The same rows in the brick before (`x div 16 − 1`).
-    pub before: [u32; 9],
-    /// The same rows in the brick after (`x div 16 + 1`).
-    pub after: [u32; 9],
+    own: [u32; 9],
+    /// Each row's hash parts but x's: y and z's part of the brick's hash, and the row's
+    /// `(y mod 4, z mod 4)` (for the bricks on either side, seldom read).
+    yz: [(u32, u32); 9],
+    row_mask: u32,
 }
 
 /// `(dy, dz)` of the nine rows, own row first.
@@ -188,13 +188,17 @@ const AROUND: [(i32, i32); 9] = [
     (1, 1),
 ];
 
+/// At most this many ranges around a cell: nine rows, and one cell across a brick's edge in
+/// each.
+pub const MAX_RANGES: usize = 18;
+
 impl RowsAround {
     /// Rows that match no cell (`key` out of the clamped range).
     pub const NONE: RowsAround = RowsAround {
         key: [i32::MIN; 3],
         own: [0; 9],
-        before: [0; 9],
-        after: [0; 9],
+        yz: [(0, 0); 9],
+        row_mask: 0,
     };
 
     /// The rows around `cell`: kept as they are when `cell` is in the same row as the cell
@@ -203,44 +207,51 @@ impl RowsAround {
     pub fn update(&mut self, cell: [i32; 3], row_mask: u32) {
         let [x, y, z] = cell;
         let key = [x >> 4, y, z];
-        if key == self.key {
+        if key == self.key && row_mask == self.row_mask {
             return;
         }
         self.key = key;
-        // `row_of`'s hash in parts: three bricks along x, then per row its y and z parts.
-        let bx = |dx: i32| brick_x(key[0].wrapping_add(dx));
-        let (before, own, after) = (bx(-1), bx(0), bx(1));
+        self.row_mask = row_mask;
+        let bx = brick_x(key[0]);
         for (i, (dy, dz)) in AROUND.into_iter().enumerate() {
             let (y, z) = (y.wrapping_add(dy), z.wrapping_add(dz));
-            let yz = brick_yz(y, z);
-            let low = ((y as u32 & 3) << 2) | (z as u32 & 3);
-            let row = |bx: u32| (((bx ^ yz) << 4) | low) & row_mask;
-            self.own[i] = row(own) * ROW;
-            self.before[i] = row(before) * ROW;
-            self.after[i] = row(after) * ROW;
+            self.yz[i] = (brick_yz(y, z), ((y as u32 & 3) << 2) | (z as u32 & 3));
+            self.own[i] = self.row(i, bx);
         }
+    }
+
+    /// Bucket offset of row `i` in the brick whose x hash part is `bx`.
+    #[inline(always)]
+    fn row(&self, i: usize, bx: u32) -> u32 {
+        let (yz, low) = self.yz[i];
+        ((((bx ^ yz) << 4) | low) & self.row_mask) * ROW
     }
 
     /// The sorted ranges of the 27 cells around `cell` (whose rows these are), in the fixed
     /// order: per row, cells `x − 1 ..= x + 1` within the row, then the one across the
-    /// brick's edge if any. Calls `range(start, end)` for each.
+    /// brick's edge if any. Writes them to `out` and returns how many.
     #[inline(always)]
-    pub fn ranges(&self, grid: &Grid, cell: [i32; 3], mut range: impl FnMut(usize, usize)) {
+    pub fn ranges(&self, grid: &Grid, cell: [i32; 3], out: &mut [(u32, u32); MAX_RANGES]) -> usize {
         let low = cell[0] as u32 & (ROW - 1);
         let (first, last) = (low.saturating_sub(1), (low + 1).min(ROW - 1));
-        for i in 0..9 {
-            let (s, e) = grid.range(self.own[i] + first, self.own[i] + last);
-            range(s as usize, e as usize);
-            if low == 0 {
-                let b = self.before[i] + ROW - 1;
-                let (s, e) = grid.range(b, b);
-                range(s as usize, e as usize);
-            } else if low == ROW - 1 {
-                let b = self.after[i];
-                let (s, e) = grid.range(b, b);
-                range(s as usize, e as usize);
+        if low != 0 && low != ROW - 1 {
+            for (i, o) in out.iter_mut().take(9).enumerate() {
+                *o = grid.range(self.own[i] + first, self.own[i] + last);
             }
+            return 9;
         }
+        // Across the edge: bucket 15 of the brick before, or bucket 0 of the one after.
+        let (side, bucket) = if low == 0 {
+            (brick_x(self.key[0].wrapping_sub(1)), ROW - 1)
+        } else {
+            (brick_x(self.key[0].wrapping_add(1)), 0)
+        };
+        for i in 0..9 {
+            out[2 * i] = grid.range(self.own[i] + first, self.own[i] + last);
+            let b = self.row(i, side) + bucket;
+            out[2 * i + 1] = grid.range(b, b);
+        }
+        MAX_RANGES
     }
 }
 
@@ -320,11 +331,13 @@ mod tests {
             rows.update([centre[0] & !15, centre[1], centre[2]], grid.row_mask());
             rows.update(centre, grid.row_mask());
             let mut times = vec![0; points.len()];
-            rows.ranges(&grid, centre, |s, e| {
+            let mut ranges = [(0, 0); MAX_RANGES];
+            let n = rows.ranges(&grid, centre, &mut ranges);
+            for &(s, e) in &ranges[..n] {
                 for k in s..e {
-                    times[order[k] as usize] += 1;
+                    times[order[k as usize] as usize] += 1;
                 }
-            });
+            }
             assert!(
                 times[..near].iter().all(|&t| t == 1),
                 "{centre:?}: {times:?}"
