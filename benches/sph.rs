@@ -10,7 +10,10 @@
 //!
 //! `cargo bench -p hairsim-benches --bench sph` (everything), or picking scenes, columns and
 //! thread counts by name: `cargo bench -p hairsim-benches --bench sph -- mannequin-a
-//! dftl+shape+hair-hair 2t`. Under
+//! dftl+shape+hair-hair 2t`. With `stage`, the SPH stage alone on the picked sizes (after the
+//! warm-up, its accelerations computed again and again on one state, on one and two threads:
+//! the fastest of `STAGE_REPEATS` per phase — the least disturbed by other processes — and the
+//! CPU time of all of them). Under
 //! `cargo test --benches` each configuration of the two smallest sizes runs two steps.
 
 use std::time::{Duration, Instant};
@@ -24,6 +27,9 @@ use hairsim_core::DefaultMath;
 const WARM_UP: u64 = 30;
 /// Steps timed.
 const STEPS: u64 = 20;
+
+/// Times the SPH stage runs on one state with `stage`.
+const STAGE_REPEATS: usize = 15;
 
 /// A Table 1 size: name, strands, nodes per strand (vertices = strands × nodes; the paper's
 /// count in the comment where it is not a multiple).
@@ -132,6 +138,68 @@ fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, 
     );
 }
 
+/// The SPH stage alone on `size`'s warmed-up state, on one and two threads.
+fn stage<const N: usize>(size: &Size, warm_up: u64, repeats: usize) {
+    let prepared = scene(size, "dftl+shape+hair-hair");
+    let mut sim = Sim::<N, DefaultMath>::new(&prepared, 2).unwrap();
+    sim.in_pool(|sim| {
+        for k in 0..warm_up {
+            sim.step(&scene_inputs::<DefaultMath>(&prepared, k));
+        }
+    });
+    let dt = prepared.params.dt;
+    let mut acc = vec![hairsim_core::Vec3::ZERO; sim.strands.len() * N];
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut sph = sim.sph.clone().unwrap();
+        let strands = &sim.strands;
+        let (phases, cpu, wall) = pool.install(|| {
+            sph.accelerations(strands, dt, &mut acc);
+            let mut phases = [f64::INFINITY; 5];
+            let (cpu0, wall0) = (cpu_time::ProcessTime::now(), Instant::now());
+            for _ in 0..repeats {
+                let b = sph.stats.clone();
+                let t = Instant::now();
+                sph.accelerations(strands, dt, &mut acc);
+                let total = t.elapsed();
+                let s = &sph.stats;
+                let times = [
+                    s.time_hash - b.time_hash,
+                    s.time_sort - b.time_sort,
+                    s.time_neighbours - b.time_neighbours,
+                    s.time_forces - b.time_forces,
+                    total,
+                ];
+                for (p, t) in phases.iter_mut().zip(times) {
+                    *p = p.min(t.as_secs_f64() * 1e3);
+                }
+            }
+            (
+                phases,
+                cpu0.elapsed().as_secs_f64(),
+                wall0.elapsed().as_secs_f64(),
+            )
+        });
+        let per = |t: f64| t * 1e3 / repeats as f64;
+        println!(
+            "{:<12} {:>8} vertices SPH stage {} thread(s): fastest ms: hash {:.2}, sort {:.2}, neighbours {:.2}, forces {:.2}, all {:.2}; mean {:.2} ms wall, {:.2} ms CPU",
+            size.name,
+            prepared.nodes(),
+            threads,
+            phases[0],
+            phases[1],
+            phases[2],
+            phases[3],
+            phases[4],
+            per(wall),
+            per(cpu),
+        );
+    }
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--list") {
@@ -154,6 +222,22 @@ fn main() {
             named.is_empty() || named.iter().any(|f| f.as_str() == name)
         };
         if !picked(size.name, &SIZES.iter().map(|s| s.name).collect::<Vec<_>>()) {
+            continue;
+        }
+        if filter.iter().any(|f| f.as_str() == "stage") {
+            let repeats = if quick { 1 } else { STAGE_REPEATS };
+            // `warm-up=K` and `repeats=R` (for a run under a profiler or valgrind).
+            let number = |name: &str| {
+                filter
+                    .iter()
+                    .find_map(|f| f.strip_prefix(name)?.parse::<u64>().ok())
+            };
+            let warm_up = number("warm-up=").unwrap_or(warm_up);
+            let repeats = number("repeats=").map_or(repeats, |r| r as usize);
+            match size.nodes {
+                0..=16 => stage::<16>(size, warm_up, repeats),
+                _ => stage::<32>(size, warm_up, repeats),
+            }
             continue;
         }
         for column in COLUMNS {

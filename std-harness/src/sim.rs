@@ -1,14 +1,22 @@
 //! A running simulation: the harness owns a `Vec<Strand<N>>` and steps it in blocks of a
-//! fixed size (the scene's `strands_per_block`) with [`hairsim_core::step_strands`], on as many
-//! threads as asked. Each block gets its own [`StepReport`] and the reports are merged in
-//! block order, so every bit of the state and of the report is the same whatever the thread
-//! count.
+//! fixed size (the scene's `strands_per_block`), on as many threads as asked. Each block gets
+//! its own [`StepReport`] and the reports are merged in block order, so every bit of the state
+//! and of the report is the same whatever the thread count.
+//!
+//! The Kirchhoff rod steps each strand with [`hairsim_core::step_strands`]. DFTL steps each
+//! block as structure-of-arrays [`DftlBlock`]s of [`RECOMMENDED_LANES`] strands
+//! ([`hairsim_core::dftl::step_blocks`]: the same bits as the per-strand path, several times
+//! faster): the blocks keep the rest data, loaded once; every step copies the state in from
+//! the strands, steps, and copies it back while it is still in cache, so `strands` stays the
+//! state anyone reads or writes.
 
 use hairsim_core::context::StepContext;
+use hairsim_core::dftl::{step_blocks, DftlBlock, RECOMMENDED_LANES};
 use hairsim_core::grab::GrabStatus;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::{
-    step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, Stage, StepReport, Strand, Vec3,
+    step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, Solver, Stage, StepReport,
+    Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -52,6 +60,31 @@ pub fn scene_inputs<M: Math>(prepared: &Prepared, k: u64) -> StepInputs {
     }
 }
 
+/// Lanes of the DFTL blocks.
+const LANES: usize = RECOMMENDED_LANES;
+
+/// The backend `M` with the hardware's square root, which the compiler can vectorise
+/// (`libm::sqrtf` is a scalar `sqrtss`). [`Math::sqrt`] is correctly rounded in every backend
+/// and so is `f32::sqrt`: the same bits; the trigonometry stays `M`'s.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VectorSqrt<M>(std::marker::PhantomData<M>);
+
+impl<M: Math> Math for VectorSqrt<M> {
+    const NAME: &'static str = M::NAME;
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        x.sqrt()
+    }
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        M::sin_cos(x)
+    }
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        M::atan2(y, x)
+    }
+}
+
 /// A simulation of strands with capacity `N`, math backend `M`.
 pub struct Sim<const N: usize, M: Math> {
     /// Parameters.
@@ -69,6 +102,9 @@ pub struct Sim<const N: usize, M: Math> {
     /// The SPH stage, when `hair-hair` is on.
     pub sph: Option<Sph>,
     block: usize,
+    /// DFTL only: each block of `block` strands as `block.div_ceil(LANES)` SoA blocks, in
+    /// strand order (rest data loaded once; the state copied in and out every step).
+    dftl_blocks: Vec<DftlBlock<LANES, N>>,
     dftl: DftlCoefficients,
     accelerations: Vec<Vec3>,
     /// One report per block of strands, reused every step (a step allocates nothing).
@@ -96,7 +132,9 @@ impl<const N: usize, M: Math> Sim<N, M> {
             .iter()
             .map(|g| Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit))
             .collect();
-        let pool = if threads > 1 {
+        // A pool even for one thread when SPH runs: its parallel passes would otherwise go to
+        // rayon's global pool, with a thread per core.
+        let pool = if threads > 1 || prepared.sph.is_some() {
             Some(std::sync::Arc::new(
                 rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
@@ -115,6 +153,14 @@ impl<const N: usize, M: Math> Sim<N, M> {
             None => None,
         };
         let block = prepared.block.max(1);
+        let dftl_blocks = match prepared.params.solver {
+            Solver::Dftl => strands
+                .chunks(block)
+                .flat_map(|b| b.chunks(LANES))
+                .map(DftlBlock::from_strands)
+                .collect(),
+            Solver::Rod => Vec::new(),
+        };
         Ok(Sim {
             params: prepared.params,
             block_reports: vec![StepReport::default(); strands.len().div_ceil(block)],
@@ -130,6 +176,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
             steps: 0,
             sph,
             block,
+            dftl_blocks,
             // Computed once, as `World::configure` does (two `powf`, never per step).
             dftl: prepared.params.dftl.at_step(prepared.params.dt),
             pool,
@@ -210,29 +257,73 @@ impl<const N: usize, M: Math> Sim<N, M> {
         hairsim_core::grab::slip_unreachable(&ctx, &mut self.grabs, &self.strands, 0, &mut report);
         let block = self.block;
         let grabs = self.grabs.as_slice();
-        let step_block = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
-            *r = StepReport::default();
-            let acc =
-                accelerations.and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
-            step_strands::<M, N>(&ctx, strands, (b * block) as u32, grabs, acc, r);
-        };
         let reports = &mut self.block_reports;
-        match &self.pool {
-            Some(pool) if reports.len() > 1 => pool.install(|| {
-                self.strands
-                    .par_chunks_mut(block)
-                    .zip(reports.par_iter_mut())
-                    .enumerate()
-                    .for_each(|(b, (strands, r))| step_block(b, strands, r));
-            }),
-            _ => {
-                for (b, (strands, r)) in self
-                    .strands
-                    .chunks_mut(block)
-                    .zip(reports.iter_mut())
-                    .enumerate()
-                {
-                    step_block(b, strands, r);
+        let parallel = self.pool.as_ref().filter(|_| reports.len() > 1);
+        if self.dftl_blocks.is_empty() {
+            let step_block = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
+                *r = StepReport::default();
+                let acc = accelerations
+                    .and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
+                step_strands::<M, N>(&ctx, strands, (b * block) as u32, grabs, acc, r);
+            };
+            match parallel {
+                Some(pool) => pool.install(|| {
+                    self.strands
+                        .par_chunks_mut(block)
+                        .zip(reports.par_iter_mut())
+                        .enumerate()
+                        .for_each(|(b, (strands, r))| step_block(b, strands, r));
+                }),
+                None => {
+                    for (b, (strands, r)) in self
+                        .strands
+                        .chunks_mut(block)
+                        .zip(reports.iter_mut())
+                        .enumerate()
+                    {
+                        step_block(b, strands, r);
+                    }
+                }
+            }
+        } else {
+            // DFTL ignores grabs (its followers' leaders are the strands themselves).
+            let per_block = block.div_ceil(LANES);
+            let step_block = |b: usize,
+                              strands: &mut [Strand<N>],
+                              blocks: &mut [DftlBlock<LANES, N>],
+                              r: &mut StepReport| {
+                *r = StepReport::default();
+                let acc = accelerations
+                    .and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
+                for (lanes, chunk) in blocks.iter_mut().zip(strands.chunks(LANES)) {
+                    load_state(lanes, chunk);
+                }
+                step_blocks::<VectorSqrt<M>, LANES, N>(&ctx, blocks, (b * block) as u32, acc, r);
+                for (lanes, chunk) in blocks.iter().zip(strands.chunks_mut(LANES)) {
+                    lanes.store(chunk);
+                }
+            };
+            match parallel {
+                Some(pool) => pool.install(|| {
+                    self.strands
+                        .par_chunks_mut(block)
+                        .zip(self.dftl_blocks.par_chunks_mut(per_block))
+                        .zip(reports.par_iter_mut())
+                        .enumerate()
+                        .for_each(|(b, ((strands, blocks), r))| {
+                            step_block(b, strands, blocks, r);
+                        });
+                }),
+                None => {
+                    for (b, ((strands, blocks), r)) in self
+                        .strands
+                        .chunks_mut(block)
+                        .zip(self.dftl_blocks.chunks_mut(per_block))
+                        .zip(reports.iter_mut())
+                        .enumerate()
+                    {
+                        step_block(b, strands, blocks, r);
+                    }
                 }
             }
         }
@@ -244,6 +335,25 @@ impl<const N: usize, M: Math> Sim<N, M> {
         self.head = head;
         self.steps += 1;
         report
+    }
+}
+
+/// Copies the state (positions, velocities) of `strands` into the lanes of `block` they were
+/// loaded into (lane `l` from `strands[l]`): the inverse of [`DftlBlock::store`]. The rest
+/// data stays as loaded.
+fn load_state<const N: usize>(block: &mut DftlBlock<LANES, N>, strands: &[Strand<N>]) {
+    for (l, strand) in strands.iter().enumerate().take(block.strands.min(LANES)) {
+        let n = block.nodes[l].min(N);
+        for (lanes, (x, v)) in block.state.iter_mut().zip(
+            strand.state.position[..n]
+                .iter()
+                .zip(&strand.state.velocity[..n]),
+        ) {
+            for (axis, (p, u)) in x.to_array().into_iter().zip(v.to_array()).enumerate() {
+                lanes.position[axis][l] = p;
+                lanes.velocity[axis][l] = u;
+            }
+        }
     }
 }
 
@@ -271,4 +381,33 @@ fn place<const N: usize>(strand: &mut Strand<N>, head: &Pose) {
         *p = head.transform_point(*p);
     }
     strand.state.root_frame = head.transform_vector(strand.state.root_frame);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use hairsim_core::DefaultMath;
+
+    /// The DFTL block path gives the per-strand path's bits (the state and every report),
+    /// with hair–hair accelerations, collisions, shape and a turning head, on blocks of a size
+    /// that is not a multiple of the lanes (so blocks end in part-filled lanes).
+    #[test]
+    fn dftl_blocks_step_as_the_per_strand_path() {
+        let mut scene = (crate::builtin::find("mannequin-b").unwrap().scene)();
+        scene.strands_per_block = Some(40);
+        let prepared = scene.prepare().unwrap();
+        let mut blocks = Sim::<16, DefaultMath>::new(&prepared, 2).unwrap();
+        let mut per_strand = Sim::<16, DefaultMath>::new(&prepared, 2).unwrap();
+        // 12 blocks of 40 strands (3 SoA blocks: 16 + 16 + 8 lanes), then 20 strands (16 + 4).
+        assert_eq!(blocks.dftl_blocks.len(), 12 * 3 + 2);
+        per_strand.dftl_blocks.clear();
+        for k in 0..40 {
+            let inputs = scene_inputs::<DefaultMath>(&prepared, k);
+            let a = blocks.in_pool(|s| s.step(&inputs));
+            let b = per_strand.in_pool(|s| s.step(&inputs));
+            assert_eq!(a, b, "report of step {k}");
+            assert_eq!(blocks.state_hash(), per_strand.state_hash(), "step {k}");
+        }
+        assert!(blocks.sph.as_ref().unwrap().stats.neighbours > 0);
+    }
 }

@@ -26,30 +26,36 @@ use rayon::prelude::*;
 use super::neighbours::{NeighbourLists, PADDING};
 use super::{SphParams, CHUNK};
 
-/// Particles rearranged into the grid's sorted order (structure of arrays), and what is
-/// computed for them.
+/// What the counting sort moves for each particle: 32 bytes, one write per particle.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Record {
+    /// Position, m.
+    pub position: [f32; 3],
+    /// Velocity, m/s.
+    pub velocity: [f32; 3],
+    /// Mass, kg.
+    pub mass: f32,
+    /// `strand << NODE_BITS | node`.
+    pub key: u32,
+}
+
+/// Particles rearranged into the grid's sorted order, and what is computed for them.
 #[derive(Clone, Debug, Default)]
 pub struct SortedParticles {
+    /// The sorted records.
+    pub record: Vec<Record>,
     /// Positions, m: x (and [`PADDING`] entries past the last particle, never a neighbour).
     pub x: Vec<f32>,
     /// Positions, m: y.
     pub y: Vec<f32>,
     /// Positions, m: z.
     pub z: Vec<f32>,
-    /// Velocities, m/s.
-    pub velocity: Vec<Vec3>,
     /// Masses, kg.
     pub mass: Vec<f32>,
-    /// Strand of each particle.
-    pub strand: Vec<u32>,
-    /// Node index of each particle.
-    pub node: Vec<u32>,
-    /// Grid cell of each particle.
-    pub cell: Vec<[i32; 3]>,
+    /// Keys: `strand << NODE_BITS | node`.
+    pub key: Vec<u32>,
     /// Densities, kg/m³.
     pub density: Vec<f32>,
-    /// Pressures.
-    pub pressure: Vec<f32>,
     /// What a neighbour contributes: `[x, y, z, m/ρ, vx, vy, vz, p]`.
     pub packed: Vec<[f32; 8]>,
     /// Accelerations, m/s².
@@ -61,16 +67,13 @@ impl SortedParticles {
     #[must_use]
     pub fn new(n: usize) -> SortedParticles {
         SortedParticles {
+            record: vec![Record::default(); n],
             x: vec![0.0; n + PADDING],
             y: vec![0.0; n + PADDING],
             z: vec![0.0; n + PADDING],
-            velocity: vec![Vec3::ZERO; n],
             mass: vec![0.0; n],
-            strand: vec![0; n],
-            node: vec![0; n],
-            cell: vec![[0; 3]; n],
+            key: vec![0; n],
             density: vec![0.0; n],
-            pressure: vec![0.0; n],
             packed: vec![[0.0; 8]; n],
             acceleration: vec![Vec3::ZERO; n],
         }
@@ -80,6 +83,27 @@ impl SortedParticles {
     #[must_use]
     pub fn position(&self, k: usize) -> Vec3 {
         Vec3::new(self.x[k], self.y[k], self.z[k])
+    }
+
+    /// Fills the structure-of-arrays positions, masses and keys from the sorted records.
+    pub fn split(&mut self) {
+        let n = self.record.len();
+        let record = &self.record;
+        (
+            self.x[..n].par_chunks_mut(CHUNK),
+            self.y[..n].par_chunks_mut(CHUNK),
+            self.z[..n].par_chunks_mut(CHUNK),
+            self.mass.par_chunks_mut(CHUNK),
+            self.key.par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (x, y, z, m, key))| {
+                for (k, r) in record[c * CHUNK..].iter().take(x.len()).enumerate() {
+                    [x[k], y[k], z[k]] = r.position;
+                    (m[k], key[k]) = (r.mass, r.key);
+                }
+            });
     }
 }
 

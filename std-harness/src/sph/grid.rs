@@ -20,8 +20,22 @@ pub const ROW: u32 = 16;
 #[inline]
 #[must_use]
 pub fn cell_of(p: Vec3, inverse_cell: f32) -> [i32; 3] {
-    let c = |x: f32| (x * inverse_cell).floor().clamp(-1.0e9, 1.0e9) as i32;
-    [c(p.x), c(p.y), c(p.z)]
+    [
+        floor_clamped(p.x * inverse_cell),
+        floor_clamped(p.y * inverse_cell),
+        floor_clamped(p.z * inverse_cell),
+    ]
+}
+
+/// `t.floor().clamp(-1e9, 1e9) as i32` (NaN gives 0), without `floorf`: on the x86-64
+/// baseline (no SSE4.1 `roundss`) `floor` is a library call, and the hash takes three per
+/// node. Truncation toward zero, minus one where that rounded a negative value up.
+#[inline(always)]
+#[must_use]
+pub fn floor_clamped(t: f32) -> i32 {
+    let t = t.clamp(-1.0e9, 1.0e9);
+    let i = t as i32;
+    i - i32::from((i as f32) > t)
 }
 
 /// The row holding cell `(x, y, z)`. Rows come in *bricks* of 4 × 4 rows (16 × 4 × 4 cells),
@@ -31,10 +45,20 @@ pub fn cell_of(p: Vec3, inverse_cell: f32) -> [i32; 3] {
 #[inline]
 #[must_use]
 pub fn row_of(x: i32, y: i32, z: i32, row_mask: u32) -> u32 {
-    let brick = ((x >> 4) as u32).wrapping_mul(73_856_093)
-        ^ ((y >> 2) as u32).wrapping_mul(19_349_663)
-        ^ ((z >> 2) as u32).wrapping_mul(83_492_791);
+    let brick = brick_x(x >> 4) ^ brick_yz(y, z);
     ((brick << 4) | ((y as u32 & 3) << 2) | (z as u32 & 3)) & row_mask
+}
+
+/// The x part of a brick's hash, for the brick `x div 16`.
+#[inline(always)]
+fn brick_x(brick: i32) -> u32 {
+    (brick as u32).wrapping_mul(73_856_093)
+}
+
+/// The y and z parts of the hash of the brick holding rows `y`, `z`.
+#[inline(always)]
+fn brick_yz(y: i32, z: i32) -> u32 {
+    ((y >> 2) as u32).wrapping_mul(19_349_663) ^ ((z >> 2) as u32).wrapping_mul(83_492_791)
 }
 
 /// The bucket of a cell.
@@ -49,12 +73,10 @@ pub fn bucket_of(cell: [i32; 3], row_mask: u32) -> u32 {
 pub struct Grid {
     inverse_cell: f32,
     row_mask: u32,
-    /// `bucket_start[b] .. bucket_start[b + 1]` are bucket `b`'s particles in sorted order.
+    /// `bucket_start[b] .. bucket_start[b + 1]` are bucket `b`'s particles in sorted order
+    /// (one entry more, the counting sort's scratch).
     pub bucket_start: Vec<u32>,
-    cursor: Vec<u32>,
-    /// Sorted position `k` holds particle `order[k]`.
-    pub order: Vec<u32>,
-    /// Particle `p` is at sorted position `rank[p]` (the inverse of `order`).
+    /// Particle `p` is at sorted position `rank[p]`.
     pub rank: Vec<u32>,
 }
 
@@ -68,9 +90,7 @@ impl Grid {
         Grid {
             inverse_cell: 1.0 / h,
             row_mask: (rows - 1) as u32,
-            bucket_start: vec![0; buckets + 1],
-            cursor: vec![0; buckets],
-            order: vec![0; particles],
+            bucket_start: vec![0; buckets + 2],
             rank: vec![0; particles],
         }
     }
@@ -87,79 +107,151 @@ impl Grid {
         self.row_mask
     }
 
-    /// Sorts particles `0 .. bucket.len()` by their buckets. Stable: within a bucket particles
-    /// keep their index order — so the order, and every sum taken in it, is a function of
-    /// the positions alone.
-    pub fn sort(&mut self, bucket: &[u32]) {
-        self.bucket_start.fill(0);
+    /// Sorts particles `0 .. bucket.len()` by their buckets and moves each one's `record`
+    /// to its sorted place (`sorted[rank[p]] = record[p]`). Stable: within a bucket
+    /// particles keep their index order — so the order, and every sum taken in it, is a
+    /// function of the positions alone. One pass to count, one to place: the records are
+    /// read in order and each written once (no second, random-read gather).
+    pub fn sort<T: Copy>(&mut self, bucket: &[u32], record: &[T], sorted: &mut [T]) {
+        // `bucket_start[b + 1]` counts bucket `b`, then (prefix sums) is where it starts,
+        // then (each placement moves it on) where it ends: the start of bucket `b + 1`.
+        let starts = &mut self.bucket_start;
+        starts.fill(0);
         for &b in bucket {
-            self.bucket_start[b as usize + 1] += 1;
+            if let Some(count) = starts.get_mut(b as usize + 2) {
+                *count += 1;
+            }
         }
-        for b in 1..self.bucket_start.len() {
-            self.bucket_start[b] += self.bucket_start[b - 1];
+        let mut sum = 0;
+        for start in starts.iter_mut() {
+            sum += *start;
+            *start = sum;
         }
-        let buckets = self.cursor.len();
-        self.cursor.copy_from_slice(&self.bucket_start[..buckets]);
-        for (p, &b) in bucket.iter().enumerate() {
-            let slot = &mut self.cursor[b as usize];
-            self.order[*slot as usize] = p as u32;
-            self.rank[p] = *slot;
-            *slot += 1;
+        for ((&b, rank), r) in bucket.iter().zip(&mut self.rank).zip(record) {
+            let Some(cursor) = starts.get_mut(b as usize + 1) else {
+                continue;
+            };
+            *rank = *cursor;
+            if let Some(slot) = sorted.get_mut(*cursor as usize) {
+                *slot = *r;
+            }
+            *cursor += 1;
         }
     }
 
-    /// The sorted ranges holding every particle of the 27 cells around `cell`: the span of
-    /// buckets of its own three cells along x first, then the others in a fixed order, each
-    /// bucket once (rows that collide give the same span twice: it is read once).
-    /// Returns the ranges and how many there are.
+    /// The sorted range of the particles in buckets `first ..= last`.
+    #[inline(always)]
     #[must_use]
-    pub fn ranges_around(&self, cell: [i32; 3]) -> ([(u32, u32); 18], usize) {
-        let [x, y, z] = cell;
-        let low = x as u32 & (ROW - 1);
-        // Bucket spans (first, last) of cells x − 1 ..= x + 1 in the row of (y, z).
-        let spans = |y: i32, z: i32| -> [(u32, u32); 2] {
-            let row = |x: i32| row_of(x, y, z, self.row_mask) * ROW;
-            match low {
-                0 => [
-                    (row(x), row(x) + 1),
-                    (row(x - 1) + ROW - 1, row(x - 1) + ROW - 1),
-                ],
-                l if l == ROW - 1 => [
-                    (row(x) + ROW - 2, row(x) + ROW - 1),
-                    (row(x + 1), row(x + 1)),
-                ],
-                l => [(row(x) + l - 1, row(x) + l + 1), (u32::MAX, u32::MAX)],
-            }
-        };
-        // Own span first (the nearest cells, kept first when the cap truncates), then the
-        // others in the fixed (dy, dz) order, a span that collides with one already taken
-        // skipped (a linear search over at most 17: cheaper than sorting).
-        let own = spans(y, z)[0];
-        let mut taken = [own; 18];
-        let mut out = [(0, 0); 18];
-        out[0] = self.range(own);
-        let mut m = 1;
-        for dy in -1..=1 {
-            for dz in -1..=1 {
-                for span in spans(y + dy, z + dz) {
-                    if span.0 != u32::MAX && !taken[..m].contains(&span) {
-                        taken[m] = span;
-                        out[m] = self.range(span);
-                        m += 1;
-                    }
-                }
-            }
-        }
-        (out, m)
+    pub fn range(&self, first: u32, last: u32) -> (u32, u32) {
+        let s = &self.bucket_start;
+        (
+            s.get(first as usize).copied().unwrap_or(0),
+            s.get(last as usize + 1).copied().unwrap_or(0),
+        )
     }
 
-    /// The sorted range of buckets `first ..= last`.
+    /// The buckets `bucket_start[b] .. bucket_start[b + 1]` start at.
+    #[must_use]
+    pub fn buckets(&self) -> usize {
+        self.bucket_start.len() - 2
+    }
+}
+
+/// The nine rows around a cell's row — `(y + dy, z + dz)` for `dy, dz` in −1 ..= 1, own row
+/// first, then the others in `(dy, dz)` order — as bucket offsets (row · [`ROW`]), for the
+/// brick of `x div 16` and the bricks on either side (read only where `x mod 16` is 0 or 15).
+///
+/// The nine rows are always distinct, so no bucket is ever read twice: their low four bits are
+/// `((y + dy) mod 4, (z + dz) mod 4)`, and three consecutive integers are distinct mod 4.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RowsAround {
+    /// The cell's `(x div 16, y, z)` these rows are for.
+    key: [i32; 3],
+    /// Bucket offset of each row in the cell's brick along x.
+    own: [u32; 9],
+    /// Each row's hash parts but x's: y and z's part of the brick's hash, and the row's
+    /// `(y mod 4, z mod 4)` (for the bricks on either side, seldom read).
+    yz: [(u32, u32); 9],
+    row_mask: u32,
+}
+
+/// `(dy, dz)` of the nine rows, own row first.
+const AROUND: [(i32, i32); 9] = [
+    (0, 0),
+    (-1, -1),
+    (-1, 0),
+    (-1, 1),
+    (0, -1),
+    (0, 1),
+    (1, -1),
+    (1, 0),
+    (1, 1),
+];
+
+/// At most this many ranges around a cell: nine rows, and one cell across a brick's edge in
+/// each.
+pub const MAX_RANGES: usize = 18;
+
+impl RowsAround {
+    /// Rows that match no cell (`key` out of the clamped range).
+    pub const NONE: RowsAround = RowsAround {
+        key: [i32::MIN; 3],
+        own: [0; 9],
+        yz: [(0, 0); 9],
+        row_mask: 0,
+    };
+
+    /// The rows around `cell`: kept as they are when `cell` is in the same row as the cell
+    /// they were computed for (consecutive sorted particles mostly are).
     #[inline]
-    fn range(&self, (first, last): (u32, u32)) -> (u32, u32) {
-        (
-            self.bucket_start[first as usize],
-            self.bucket_start[last as usize + 1],
-        )
+    pub fn update(&mut self, cell: [i32; 3], row_mask: u32) {
+        let [x, y, z] = cell;
+        let key = [x >> 4, y, z];
+        if key == self.key && row_mask == self.row_mask {
+            return;
+        }
+        self.key = key;
+        self.row_mask = row_mask;
+        let bx = brick_x(key[0]);
+        for (i, (dy, dz)) in AROUND.into_iter().enumerate() {
+            let (y, z) = (y.wrapping_add(dy), z.wrapping_add(dz));
+            self.yz[i] = (brick_yz(y, z), ((y as u32 & 3) << 2) | (z as u32 & 3));
+            self.own[i] = self.row(i, bx);
+        }
+    }
+
+    /// Bucket offset of row `i` in the brick whose x hash part is `bx`.
+    #[inline(always)]
+    fn row(&self, i: usize, bx: u32) -> u32 {
+        let (yz, low) = self.yz[i];
+        ((((bx ^ yz) << 4) | low) & self.row_mask) * ROW
+    }
+
+    /// The sorted ranges of the 27 cells around `cell` (whose rows these are), in the fixed
+    /// order: per row, cells `x − 1 ..= x + 1` within the row, then the one across the
+    /// brick's edge if any. Writes them to `out` and returns how many.
+    #[inline(always)]
+    pub fn ranges(&self, grid: &Grid, cell: [i32; 3], out: &mut [(u32, u32); MAX_RANGES]) -> usize {
+        let low = cell[0] as u32 & (ROW - 1);
+        let (first, last) = (low.saturating_sub(1), (low + 1).min(ROW - 1));
+        if low != 0 && low != ROW - 1 {
+            for (i, o) in out.iter_mut().take(9).enumerate() {
+                *o = grid.range(self.own[i] + first, self.own[i] + last);
+            }
+            return 9;
+        }
+        // Across the edge: bucket 15 of the brick before, or bucket 0 of the one after.
+        let (side, bucket) = if low == 0 {
+            (brick_x(self.key[0].wrapping_sub(1)), ROW - 1)
+        } else {
+            (brick_x(self.key[0].wrapping_add(1)), 0)
+        };
+        for i in 0..9 {
+            out[2 * i] = grid.range(self.own[i] + first, self.own[i] + last);
+            let b = self.row(i, side) + bucket;
+            out[2 * i + 1] = grid.range(b, b);
+        }
+        MAX_RANGES
     }
 }
 
@@ -180,11 +272,13 @@ mod tests {
             .iter()
             .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.row_mask()))
             .collect();
-        grid.sort(&bucket);
+        let index: Vec<u32> = (0..points.len() as u32).collect();
+        let mut order = vec![u32::MAX; points.len()];
+        grid.sort(&bucket, &index, &mut order);
         let mut seen = vec![false; points.len()];
-        for b in 0..grid.cursor.len() {
+        for b in 0..grid.buckets() {
             let range = grid.bucket_start[b] as usize..grid.bucket_start[b + 1] as usize;
-            let members = &grid.order[range.clone()];
+            let members = &order[range.clone()];
             // Stable: ascending particle index within each bucket.
             assert!(members.windows(2).all(|w| w[0] < w[1]));
             for (k, &p) in range.zip(members) {
@@ -199,7 +293,14 @@ mod tests {
     #[test]
     fn the_ranges_around_a_cell_hold_its_27_cells_each_particle_once() {
         // Few rows (16), many cells: rows and buckets collide, and x wraps at 0 and 15.
-        for centre in [[0, 0, 0], [15, 3, -2], [16, -7, 9], [-1, 5, 5], [31, 0, 1]] {
+        for centre in [
+            [0, 0, 0],
+            [15, 3, -2],
+            [16, -7, 9],
+            [-1, 5, 5],
+            [31, 0, 1],
+            [14, 1, 2],
+        ] {
             let mut points = Vec::new();
             for dx in -1..=1 {
                 for dy in -1..=1 {
@@ -222,12 +323,19 @@ mod tests {
                 .iter()
                 .map(|&p| bucket_of(cell_of(p, 1.0), grid.row_mask()))
                 .collect();
-            grid.sort(&bucket);
-            let (ranges, n) = grid.ranges_around(centre);
+            let index: Vec<u32> = (0..points.len() as u32).collect();
+            let mut order = vec![0; points.len()];
+            grid.sort(&bucket, &index, &mut order);
+            let mut rows = RowsAround::NONE;
+            // Rows computed for another cell of the same row, then reused.
+            rows.update([centre[0] & !15, centre[1], centre[2]], grid.row_mask());
+            rows.update(centre, grid.row_mask());
             let mut times = vec![0; points.len()];
+            let mut ranges = [(0, 0); MAX_RANGES];
+            let n = rows.ranges(&grid, centre, &mut ranges);
             for &(s, e) in &ranges[..n] {
                 for k in s..e {
-                    times[grid.order[k as usize] as usize] += 1;
+                    times[order[k as usize] as usize] += 1;
                 }
             }
             assert!(
@@ -236,6 +344,20 @@ mod tests {
             );
             assert!(times.iter().all(|&t| t <= 1), "{centre:?}");
         }
+    }
+
+    #[test]
+    fn the_fast_floor_is_floor() {
+        for t in [
+            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999_999, -2.000_001, 1.0e8, -1.0e8, 3.0e9, -3.0e9,
+        ] {
+            assert_eq!(
+                floor_clamped(t),
+                t.floor().clamp(-1.0e9, 1.0e9) as i32,
+                "{t}"
+            );
+        }
+        assert_eq!(floor_clamped(f32::NAN), 0);
     }
 
     #[test]

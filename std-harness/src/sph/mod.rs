@@ -4,7 +4,8 @@
 //! Particles are the strand nodes. Each step:
 //! 1. [`grid`] hashes every node into cells the size of the smoothing length `h` and sorts them
 //!    by bucket with a **stable counting sort** (Algorithm 1 lines 2–4);
-//! 2. positions, velocities and masses are rearranged into that order (line 5);
+//! 2. positions, velocities and masses are rearranged into that order (line 5), moved by the
+//!    sort itself as one 32-byte record per particle;
 //! 3. [`neighbours`] builds a capped neighbour list per node (the paper's rough k-nearest list,
 //!    line 6) and, in the same pass, density (poly6) and pressure (line 7);
 //! 4. [`forces`] computes the pressure (spiky gradient) and viscosity (viscosity Laplacian)
@@ -129,12 +130,8 @@ pub struct Sph {
     mass: Vec<f32>,
     /// First particle of each strand, and one past the last strand's.
     first: Vec<u32>,
-    /// Positions, unsorted order.
-    position: Vec<Vec3>,
-    /// Velocities, unsorted order.
-    velocity: Vec<Vec3>,
-    /// Cell of each particle, unsorted order.
-    cell: Vec<[i32; 3]>,
+    /// Each particle's record, unsorted order.
+    record: Vec<forces::Record>,
     /// Bucket of each particle, unsorted order.
     bucket: Vec<u32>,
     grid: grid::Grid,
@@ -151,6 +148,14 @@ impl Sph {
         params.validate()?;
         let count: usize = strands.iter().map(|s| s.nodes()).sum();
         u32::try_from(strands.len() * N).map_err(|_| "too many nodes for SPH")?;
+        // A particle's key holds its strand and node in one u32.
+        if N > 1 << neighbours::NODE_BITS || strands.len() >= 1 << (32 - neighbours::NODE_BITS) {
+            return Err(format!(
+                "SPH takes at most {} nodes a strand and {} strands",
+                1 << neighbours::NODE_BITS,
+                (1u32 << (32 - neighbours::NODE_BITS)) - 1
+            ));
+        }
         let mut slot = Vec::with_capacity(count);
         let mut strand_of = Vec::with_capacity(count);
         let mut node_of = Vec::with_capacity(count);
@@ -176,9 +181,7 @@ impl Sph {
             node: node_of,
             mass,
             first,
-            position: vec![Vec3::ZERO; count],
-            velocity: vec![Vec3::ZERO; count],
-            cell: vec![[0; 3]; count],
+            record: vec![forces::Record::default(); count],
             bucket: vec![0; count],
             stats: SphStats::default(),
         })
@@ -211,33 +214,37 @@ impl Sph {
         let t0 = Instant::now();
         // Algorithm 1, line 2: read every node and hash it into a cell of size h.
         let (inverse_cell, row_mask) = (self.grid.inverse_cell(), self.grid.row_mask());
-        let (strand, node) = (&self.strand, &self.node);
+        let (strand, node, mass) = (&self.strand, &self.node, &self.mass);
         (
-            self.position.par_chunks_mut(CHUNK),
-            self.velocity.par_chunks_mut(CHUNK),
-            self.cell.par_chunks_mut(CHUNK),
+            self.record.par_chunks_mut(CHUNK),
             self.bucket.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .for_each(|(c, (position, velocity, cell, bucket))| {
-                for k in 0..position.len() {
+            .for_each(|(c, (record, bucket))| {
+                for (k, (r, b)) in record.iter_mut().zip(bucket).enumerate() {
                     let p = c * CHUNK + k;
-                    let (s, i) = (strand[p] as usize, node[p] as usize);
-                    let (x, v) = strands.get(s).map_or((Vec3::ZERO, Vec3::ZERO), |s| {
-                        (s.state.position[i], s.state.velocity[i])
-                    });
-                    position[k] = x;
-                    velocity[k] = v;
-                    cell[k] = grid::cell_of(x, inverse_cell);
-                    bucket[k] = grid::bucket_of(cell[k], row_mask);
+                    let (s, i) = (strand[p], node[p]);
+                    let (x, v) = strands
+                        .get(s as usize)
+                        .map_or((Vec3::ZERO, Vec3::ZERO), |s| {
+                            (s.state.position[i as usize], s.state.velocity[i as usize])
+                        });
+                    *r = forces::Record {
+                        position: x.to_array(),
+                        velocity: v.to_array(),
+                        mass: mass[p],
+                        key: s << neighbours::NODE_BITS | i,
+                    };
+                    *b = grid::bucket_of(grid::cell_of(x, inverse_cell), row_mask);
                 }
             });
         let t1 = Instant::now();
-        // Lines 3–4: stable counting sort by bucket.
-        self.grid.sort(&self.bucket);
-        // Line 5: rearrange into the sorted order.
-        self.gather();
+        // Lines 3–5: stable counting sort by bucket, each record moved to its sorted place;
+        // then the positions, masses and keys as the search reads them.
+        self.grid
+            .sort(&self.bucket, &self.record, &mut self.sorted.record);
+        self.sorted.split();
         let t2 = Instant::now();
         // Lines 6–7: capped neighbour lists, density and pressure.
         let found = self
@@ -271,40 +278,6 @@ impl Sph {
         self.stats.time_sort += t2 - t1;
         self.stats.time_neighbours += t3 - t2;
         self.stats.time_forces += t4 - t3;
-    }
-
-    /// Fills the sorted arrays from the unsorted ones (sorted slot `k` from particle
-    /// `order[k]`).
-    fn gather(&mut self) {
-        let order = &self.grid.order;
-        let (position, velocity, cell) = (&self.position, &self.velocity, &self.cell);
-        let (mass, strand, node) = (&self.mass, &self.strand, &self.node);
-        let s = &mut self.sorted;
-        let n = order.len();
-        (
-            s.x[..n].par_chunks_mut(CHUNK),
-            s.y[..n].par_chunks_mut(CHUNK),
-            s.z[..n].par_chunks_mut(CHUNK),
-            s.velocity.par_chunks_mut(CHUNK),
-            s.mass.par_chunks_mut(CHUNK),
-            s.strand.par_chunks_mut(CHUNK),
-            s.node.par_chunks_mut(CHUNK),
-            s.cell.par_chunks_mut(CHUNK),
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(c, (x, y, z, v, m, st, nd, ce))| {
-                for k in 0..x.len() {
-                    let p = order[c * CHUNK + k] as usize;
-                    let q = position[p];
-                    (x[k], y[k], z[k]) = (q.x, q.y, q.z);
-                    v[k] = velocity[p];
-                    m[k] = mass[p];
-                    st[k] = strand[p];
-                    nd[k] = node[p];
-                    ce[k] = cell[p];
-                }
-            });
     }
 }
 
@@ -450,16 +423,20 @@ mod tests {
                 sph.stats.neighbours
             );
             // Same neighbour sets, exactly.
-            for (k, &p) in sph.grid.order.iter().enumerate() {
+            for (p, &k) in sph.grid.rank.iter().enumerate() {
+                let k = k as usize;
                 let mut got: Vec<(u32, u32)> = sph
                     .neighbours
                     .of(k)
                     .iter()
-                    .map(|&b| (sph.sorted.strand[b as usize], sph.sorted.node[b as usize]))
+                    .map(|&b| {
+                        let key = sph.sorted.key[b as usize];
+                        (key >> neighbours::NODE_BITS, key & 255)
+                    })
                     .collect();
                 got.sort();
-                assert_eq!(got, sets[p as usize], "particle {p}");
-                let rel = (sph.sorted.density[k] - density[p as usize]).abs() / density[p as usize];
+                assert_eq!(got, sets[p], "particle {p}");
+                let rel = (sph.sorted.density[k] - density[p]).abs() / density[p];
                 assert!(rel < 1e-5, "density of {p}: {rel}");
             }
             // Same accelerations within rounding (sums run in another order).
