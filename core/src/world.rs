@@ -61,7 +61,12 @@ pub fn step_strands<M: Math, const N: usize>(
         // outrun by a configuration past its stability limit, so only the rod checks reach.
         let inextensible = matches!(ctx.params.solver, Solver::Rod)
             && ctx.has(crate::effects::Effect::Inextensibility);
-        crate::guard::check(strand, &last_good, inextensible, index, report);
+        let rolled_back = crate::guard::check(strand, &last_good, inextensible, index, report);
+        // 4. A rod strand the explicit bending substeps lost takes the implicit step from now
+        // on (`RodRest::implicit_bending`).
+        if rolled_back && ctx.params.solver == Solver::Rod {
+            strand.rest.rod.implicit_bending = true;
+        }
     }
 }
 

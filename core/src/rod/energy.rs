@@ -59,6 +59,13 @@ pub struct RodRest<const N: usize, R = Real> {
     /// `(h²/2)·√(ρA / (max(1, µ) α))` with `h` the shortest segment (DESIGN.md "Stability");
     /// infinite without bending stiffness.
     pub stable_time_step: R,
+    /// Set when the strand's current shape is folded sharper than its explicit substeps can
+    /// hold, or when it diverged and was rolled back: from then on it takes the linearly
+    /// implicit bending step whatever its substep count (`rod::implicit`). Such states — a
+    /// fold near a hairpin, nodes pushed out of a collider — are ones the implicit step
+    /// holds (tests/torture.rs); the step's cost stays bounded by the implicit step's. Not
+    /// state: a setting the run has earned, kept across roll-backs.
+    pub implicit_bending: bool,
 }
 
 impl<const N: usize, R: Scalar> RodRest<N, R> {
@@ -86,6 +93,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
             rest_twist_rotation: [[R::ONE, R::ZERO]; N],
             rest_curvature: [[[R::ZERO; 2]; 2]; N],
             stable_time_step: R::of(f32::INFINITY),
+            implicit_bending: false,
         };
         if nodes < 3 {
             return rest;
