@@ -62,7 +62,7 @@ def main():
         k = lambda v: "/".join(f"{x / 1000:.1f}" for x in v)
         print(f"| {solver} | {nodes} | {k(calm)} | {k(violent)} | "
               f"{violent[2] / calm[1]:.3f} | {cycles / CLOCK_HZ * 1e6:.0f} | {'yes' if fits else 'no'} |")
-    for solver in ("rod", "dftl"):
+    for solver in ("rod", "dftl", "dftl_noshape"):
         print(f"largest {solver} scene within half a 1 ms tick at 168 MHz: "
               f"{best.get(solver, 0) or 'none of those measured'} nodes")
 

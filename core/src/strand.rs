@@ -236,14 +236,26 @@ impl<const N: usize> Strand<N> {
 
     /// Whether every value of the state is finite.
     #[must_use]
+    #[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
     pub fn is_finite(&self) -> bool {
-        let n = self.rest.nodes;
-        self.state.position[..n]
+        let n = self.rest.nodes.min(N);
+        // One sum of `x − x` over every value, no branch per value (the guard runs on every
+        // strand every step): 0 while all are finite, NaN as soon as one is not.
+        let mut poison: Real = 0.0;
+        let state = &self.state;
+        for ((p, v), t) in state
+            .position
             .iter()
-            .chain(self.state.velocity[..n].iter())
-            .all(|v| crate::math::is_finite(*v))
-            && self.state.theta[..n].iter().all(|t| t.is_finite())
-            && crate::math::is_finite(self.state.root_frame)
+            .zip(&state.velocity)
+            .zip(&state.theta)
+            .take(n)
+        {
+            poison = poison
+                + ((p.x - p.x) + (p.y - p.y) + (p.z - p.z))
+                + ((v.x - v.x) + (v.y - v.y) + (v.z - v.z))
+                + (t - t);
+        }
+        poison == 0.0 && crate::math::is_finite(state.root_frame)
     }
 }
 

@@ -42,7 +42,7 @@ fn stats(t: &mut [u32]) -> (u32, u32, u32) {
     (t[0], t[t.len() / 2], t[t.len() - 1])
 }
 
-fn params(solver: Solver) -> Params {
+fn params(solver: Solver, shape: bool) -> Params {
     let effects = match solver {
         Solver::Rod => Effects::from_slice(&[
             Effect::Gravity,
@@ -57,8 +57,12 @@ fn params(solver: Solver) -> Params {
             Effect::Drag,
             Effect::Inextensibility,
             Effect::Collisions,
-            Effect::Shape,
         ]),
+    };
+    let effects = if shape {
+        effects.with(Effect::Shape)
+    } else {
+        effects
     };
     let mut params = Params {
         solver,
@@ -82,8 +86,9 @@ fn build<const S: usize, const N: usize, M: Math>(
     strands: usize,
     nodes: usize,
     violent: bool,
+    shape: bool,
 ) -> bool {
-    let mut ok = world.configure(params(solver)).is_ok();
+    let mut ok = world.configure(params(solver, shape)).is_ok();
     ok &= world
         .add_collider(Collider {
             shape: Shape::Sphere {
@@ -116,11 +121,12 @@ fn measure<const S: usize, const N: usize, M: Math>(
     solver: Solver,
     strands: usize,
     nodes: usize,
+    shape: bool,
 ) {
     let mut line = [(0u32, 0u32, 0u32); 2];
     for (v, violent) in [false, true].into_iter().enumerate() {
         *world = World::new();
-        if !build(world, solver, strands, nodes, violent) {
+        if !build(world, solver, strands, nodes, violent, shape) {
             hprintln!(
                 "latency error: cannot build {} strands of {} nodes",
                 strands,
@@ -147,9 +153,10 @@ fn measure<const S: usize, const N: usize, M: Math>(
         }
         line[v] = stats(t);
     }
-    let name = match solver {
-        Solver::Rod => "rod",
-        Solver::Dftl => "dftl",
+    let name = match (solver, shape) {
+        (Solver::Rod, _) => "rod",
+        (Solver::Dftl, true) => "dftl",
+        (Solver::Dftl, false) => "dftl_noshape",
     };
     hprintln!(
         "latency {} strands {} nodes {} calm {} {} {} violent {} {} {}",
@@ -174,19 +181,24 @@ static mut ROD: RodWorld<crate::Vsqrt> = World::new();
 static mut SMALL_ROD: SmallRodWorld<crate::Vsqrt> = World::new();
 static mut DFTL: DftlWorld<crate::Vsqrt> = World::new();
 
-/// Runs every measurement: rod 16–256 nodes, DFTL 64–1024 vertices.
+/// Runs every measurement: rod 16–256 nodes, DFTL 64–1024 vertices with and without shape
+/// preservation (`dftl`, `dftl_noshape`).
 pub fn run() {
     // SAFETY: called once from `main`, nothing else touches these statics.
     // One 16-node strand as well, in a world of that capacity: the largest rod scene that
     // fits half a tick lies below 32 nodes.
     let small = unsafe { &mut *core::ptr::addr_of_mut!(SMALL_ROD) };
-    measure(small, Solver::Rod, 1, 16);
+    measure(small, Solver::Rod, 1, 16, false);
     let rod = unsafe { &mut *core::ptr::addr_of_mut!(ROD) };
     for strands in [1, 2, 4, 8] {
-        measure(rod, Solver::Rod, strands, 32);
+        measure(rod, Solver::Rod, strands, 32, false);
     }
     let dftl = unsafe { &mut *core::ptr::addr_of_mut!(DFTL) };
+    // DFTL with shape preservation (the scenes' default), then the same without it.
     for strands in [4, 8, 16, 32, 64] {
-        measure(dftl, Solver::Dftl, strands, 16);
+        measure(dftl, Solver::Dftl, strands, 16, true);
+    }
+    for strands in [4, 8, 16, 32, 64] {
+        measure(dftl, Solver::Dftl, strands, 16, false);
     }
 }

@@ -61,6 +61,10 @@ fn push_out_of_ball<M: Math, T: Lane>(x: V3<T>, centre: V3<T>, radius: Real) -> 
     let d = x - centre;
     let distance2 = d.dot(d);
     let inside = distance2.lt(T::splat(radius * radius));
+    if !T::any(inside) {
+        // Every lane keeps `x` (the select below): no square root, no division.
+        return (x, inside);
+    }
     let distance = distance2.sqrt::<M>();
     let normal = V3::select(
         T::splat(0.0).lt(distance),
@@ -74,7 +78,13 @@ fn push_out_of_ball<M: Math, T: Lane>(x: V3<T>, centre: V3<T>, radius: Real) -> 
 #[inline(always)]
 fn ball_depth<M: Math, T: Lane>(x: V3<T>, centre: V3<T>, radius: Real) -> T {
     let d = x - centre;
-    let distance = d.dot(d).sqrt::<M>();
+    let distance2 = d.dot(d);
+    // `√d² < r` needs `d² < r² (1 + 2⁻²³)²` (a correctly rounded root): with a margin of 1e-5
+    // no lane beyond it can be inside, and the select below would give 0 everywhere.
+    if !T::any(distance2.lt(T::splat(radius * radius * (1.0 + 1e-5)))) {
+        return T::splat(0.0);
+    }
+    let distance = distance2.sqrt::<M>();
     T::select(
         distance.lt(T::splat(radius)),
         T::splat(radius) - distance,

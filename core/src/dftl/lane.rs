@@ -46,6 +46,9 @@ pub trait Lane:
     /// Whether every lane of `mask` is set (to skip work no lane needs: never to change a
     /// lane's result, so a block and the per-strand path still give the same bits).
     fn all(mask: Self::Mask) -> bool;
+    /// Whether any lane of `mask` is set (as [`Lane::all`]: only to skip work whose result no
+    /// lane would select).
+    fn any(mask: Self::Mask) -> bool;
 }
 
 impl Lane for Real {
@@ -88,6 +91,10 @@ impl Lane for Real {
     }
     #[inline(always)]
     fn all(mask: bool) -> bool {
+        mask
+    }
+    #[inline(always)]
+    fn any(mask: bool) -> bool {
         mask
     }
 }
@@ -177,6 +184,10 @@ impl<const W: usize> Lane for Wide<W> {
     #[inline(always)]
     fn all(mask: WideMask<W>) -> bool {
         mask.0.iter().fold(true, |a, &b| a & b)
+    }
+    #[inline(always)]
+    fn any(mask: WideMask<W>) -> bool {
+        mask.0.iter().fold(false, |a, &b| a | b)
     }
 }
 

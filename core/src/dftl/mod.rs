@@ -305,10 +305,14 @@ pub fn advance<M: Math, T: Lane>(
     // Line 20: collisions (each collider in turn), then what is left inside.
     let mut contact = T::mask(false);
     if setup.collisions {
-        let mass = T::splat(1.0) / node.inverse_mass;
         for (shape, push) in colliders.iter().zip(measures.collider_push.iter_mut()) {
             let (pushed, inside) = collisions::push_out::<M, T>(shape, x);
-            *push = *push + V3::select(active, (pushed - x).scale(mass), V3::zero());
+            // Where no lane was pushed, `pushed − x` is 0 in every lane: nothing to add (and
+            // no division for the mass).
+            if T::any(inside) {
+                let mass = T::splat(1.0) / node.inverse_mass;
+                *push = *push + V3::select(active, (pushed - x).scale(mass), V3::zero());
+            }
             x = pushed;
             contact = contact | inside;
         }
