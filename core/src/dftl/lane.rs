@@ -33,7 +33,9 @@ pub trait Lane:
     fn sqrt<M: Math>(self) -> Self;
     /// `|x|`.
     fn abs(self) -> Self;
-    /// `f32::max` per lane (a NaN operand gives the other).
+    /// The larger of the two per lane; `self` where they are equal or `other` is NaN (the
+    /// running maximum keeps its value). A compare and a select: `f32::max` is a library
+    /// call on the Cortex-M4F (no `VMAXNM`) and a five-instruction NaN fix-up on SSE2.
     fn max(self, other: Self) -> Self;
     /// `self < other` per lane.
     fn lt(self, other: Self) -> Self::Mask;
@@ -67,7 +69,11 @@ impl Lane for Real {
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        Real::max(self, other)
+        if other > self {
+            other
+        } else {
+            self
+        }
     }
     #[inline(always)]
     fn lt(self, other: Self) -> bool {
@@ -157,7 +163,13 @@ impl<const W: usize> Lane for Wide<W> {
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        Wide(core::array::from_fn(|l| self.0[l].max(other.0[l])))
+        Wide(core::array::from_fn(|l| {
+            if other.0[l] > self.0[l] {
+                other.0[l]
+            } else {
+                self.0[l]
+            }
+        }))
     }
     #[inline(always)]
     fn lt(self, other: Self) -> WideMask<W> {
