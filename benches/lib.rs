@@ -17,3 +17,6 @@ pub fn cpu_seconds() -> f64 {
     };
     (ticks(11) + ticks(12)) / 100.0
 }
+
+/// Kmoch 2009 Table 3's scene (the `rod_projection` bench and its instruction-count example).
+pub mod table3;
