@@ -194,8 +194,10 @@ pub fn slip_unreachable<const N: usize>(
             let Some((rest_b, _, node_b, target_b)) = held(grabs, b, strands, first_strand) else {
                 continue;
             };
-            // Two grabs on the same strand share its rest data.
+            // Two grabs on the same strand share its rest data; on the same node the first
+            // holds it and the other is ignored (`grabbed_nodes`), so they are no pair.
             if core::ptr::eq(rest, rest_b)
+                && node_a != node_b
                 && !within_reach(
                     rest,
                     node_a.min(node_b),
