@@ -36,7 +36,7 @@ pub struct StepContext {
 
 impl StepContext {
     /// The context of a step that moves the head from `previous_head` to `head`. Evaluates
-    /// DFTL's rescaled coefficients (two `powf`); callers stepping many times should compute
+    /// DFTL's rescaled coefficients (two divisions); callers stepping many times should compute
     /// them once with [`crate::params::DftlParams::at_step`] and use [`Self::with_coefficients`].
     #[must_use]
     pub fn new(params: &Params, previous_head: Pose, head: Pose, colliders: &[Collider]) -> Self {

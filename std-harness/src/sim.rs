@@ -177,7 +177,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
             sph,
             block,
             dftl_blocks,
-            // Computed once, as `World::configure` does (two `powf`, never per step).
+            // Computed once, as `World::configure` does (two divisions, never per step).
             dftl: prepared.params.dftl.at_step(prepared.params.dt),
             pool,
             math: std::marker::PhantomData,
