@@ -17,10 +17,13 @@
 //! strand bent to a turning angle `φ` is `dt_max · (1 + cos φ)/2` ([`substeps_for_shape`]). A
 //! shaking head bends strands at the root to `φ ≈ 2 rad` (`1 + cos φ ≈ 0.5`, measured on the
 //! firmware scene); a count from the straight limit alone let its stiffest mode run at 3× the
-//! limit and blow up. The allowance 4 covers turning angles up to 120°. In *converge* mode a
-//! strand bent further takes more substeps (up to [`MAX_SUBSTEPS`]); in *fixed-cost* mode it
-//! does not (a sharper fold than 120° between two 1 cm segments is not hair-like; the
-//! projection and the guard keep it finite).
+//! limit and blow up. The allowance 4 covers turning angles up to 120°. In *fixed-cost* mode
+//! that count holds on every step, whatever the shape (a sharper fold than 120° between two
+//! 1 cm segments is not hair-like; the projection and the guard keep it finite). In
+//! *converge* mode the count comes instead from the shape each step starts from, with
+//! [`STEP_ALLOWANCE`] for the fold to tighten during the step ([`substeps_within_step`]):
+//! 3 substeps rather than 4 for human hair at 1 cm and 1 ms while its turning angles stay
+//! small, more for a sharper fold (up to [`MAX_SUBSTEPS`]).
 //!
 //! With [`PROJECTED_SUBSTEPS_FROM`] or more substeps the segment lengths are also projected
 //! between substeps (`inextensibility_between_substeps`): a curved strand's bending forces
@@ -251,6 +254,32 @@ pub fn substeps_for_shape<const N: usize>(
     substeps_at_stiffness(rest, dt, bending, stiffening)
 }
 
+/// How much a fold may tighten within one step in converge mode, as a factor on the
+/// stiffening `2/(1 + cos φ)` of the shape the step starts from ([`substeps_within_step`]):
+/// 2.2 lets `φ` go from 0 to 95° in one step. With 1.5 (2 substeps for straight human hair)
+/// the rest-drift test saw 1.13e-6 m, above its bound (`step::tests`); with 2.2 (3 substeps)
+/// at most 0.90e-6 m.
+pub const STEP_ALLOWANCE: Real = 2.2;
+
+/// Converge mode's substeps: the limit of the shape the step starts from
+/// ([`substeps_for_shape`]) with [`STEP_ALLOWANCE`] for the fold to tighten during the step,
+/// in place of [`FOLD_ALLOWANCE`]'s worst fold. A human hair hanging or swinging on a shaking
+/// head (turning angles below ~30°) takes 3 substeps at 1 cm and 1 ms instead of the fixed 4;
+/// the cost of a step then follows the shape (not fixed cost's promise).
+#[must_use]
+pub fn substeps_within_step<const N: usize>(
+    rest: &RodRest<N>,
+    dt: Real,
+    smallest_denominator: Real,
+) -> u32 {
+    let stiffening = if smallest_denominator > 0.0 {
+        2.0 / smallest_denominator.min(2.0)
+    } else {
+        Real::INFINITY
+    };
+    substeps_at_stiffness(rest, dt, true, stiffening * STEP_ALLOWANCE)
+}
+
 /// `⌈dt · stiffening / (SAFETY · dt_max)⌉` clamped to `1 ..= MAX_SUBSTEPS`; `stiffening ≥ 1`
 /// divides the rest limit `dt_max`.
 fn substeps_at_stiffness<const N: usize>(
@@ -273,8 +302,8 @@ fn substeps_at_stiffness<const N: usize>(
     }
 }
 
-/// Stages (1) and (2), `k` times with `h = dt/k` ([`substeps`]; in converge mode more for a
-/// fold past [`FOLD_ALLOWANCE`], [`substeps_for_shape`]): the elastic forces of
+/// Stages (1) and (2), `k` times with `h = dt/k` ([`substeps`]; in converge mode from the
+/// current shape, [`substeps_within_step`]): the elastic forces of
 /// Kmoch Sec. 7.2 at the current `θ` ([`elastic_forces_with_angles`]), then
 /// [`external_forces_and_integrate`]. Returns `(cos θ^j, sin θ^j)` of the angles it used
 /// (the hair-optimised twist compares against them).
@@ -294,13 +323,17 @@ fn forces_and_integrate<M: Math, const N: usize>(
     // The frames of the shape the step starts from: they set the substep count and serve the
     // first substep's forces.
     let mut frames = elastic.then(|| strand_frames::<M, N>(strand));
-    let for_shape = match &frames {
-        Some(frames) if terms.bending => {
-            let smallest = smallest_binormal_denominator(frames, &strand.rest.rod.rest_length);
-            substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest)
-        }
-        _ => fixed,
+    // The sharpest fold's `1 + cos φ` (2 when straight; none without bending).
+    let smallest = match &frames {
+        Some(frames) if terms.bending => Some(smallest_binormal_denominator(
+            frames,
+            &strand.rest.rod.rest_length,
+        )),
+        _ => None,
     };
+    let for_shape = smallest.map_or(fixed, |smallest| {
+        substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest)
+    });
     if terms.bending && for_shape >= IMPLICIT_FROM {
         // A fold sharper than substeps can hold (≥ 137° for human hair at 1 cm and 1 ms):
         // explicit substeps would whip it and lose it. The implicit step holds it, from now on
@@ -308,11 +341,14 @@ fn forces_and_integrate<M: Math, const N: usize>(
         strand.rest.rod.implicit_bending = true;
         return implicit_step::<M, N>(strand, ctx, clamped, terms, accelerations, report);
     }
-    // Converge mode adapts to a fold sharper than the allowance; fixed cost never does.
-    let k = if ctx.params.mode == Mode::Converge {
-        fixed.max(for_shape)
-    } else {
-        fixed
+    // Converge mode counts the substeps from the shape the step starts from (with a margin
+    // for the fold to tighten within the step); fixed cost takes the count from rest data
+    // and the allowance, the same on every step.
+    let k = match (smallest, ctx.params.mode) {
+        (Some(smallest), Mode::Converge) => {
+            substeps_within_step(&strand.rest.rod, ctx.dt, smallest)
+        }
+        _ => fixed,
     };
     let h = ctx.dt / k as Real;
     let mut forces = [Vec3::ZERO; N];

@@ -144,6 +144,27 @@ fn substeps_follow_the_stability_bound() {
 }
 
 #[test]
+fn converge_mode_counts_substeps_from_the_current_shape() {
+    let s = Strand::<NODES>::from_polyline(&polyline(0, 20)[..20], &Material::HUMAN_HAIR).unwrap();
+    let rest = &s.rest.rod;
+    // Straight human hair at 1 cm and 1 ms: ⌈0.94 · 2.2⌉ = 3 against the fixed 4.
+    assert_eq!(substeps_within_step(rest, 0.001, 2.0), 3);
+    assert_eq!(substeps(rest, 0.001, true), 4);
+    // Never fewer than the shape's own limit needs, and more as the fold tightens, up to the
+    // cap at a fold.
+    let mut previous = 0;
+    for g in [2.0, 1.5, 1.0, 0.5, 0.25, 0.1, 0.01, 0.0, Real::NAN] {
+        let k = substeps_within_step(rest, 0.001, g);
+        assert!(
+            k >= previous && k >= substeps_for_shape(rest, 0.001, true, g),
+            "g {g}: {k}"
+        );
+        previous = k;
+    }
+    assert_eq!(previous, MAX_SUBSTEPS);
+}
+
+#[test]
 fn substeps_grow_as_the_binormal_denominator_shrinks() {
     let s = Strand::<NODES>::from_polyline(&polyline(0, 20)[..20], &Material::HUMAN_HAIR).unwrap();
     let rest = &s.rest.rod;
