@@ -1,7 +1,7 @@
 //! The structure-of-arrays block path: `W` strands side by side, node index `k` of every lane
 //! together (SB15 Sec. 4's particle-level layout; Jolt's vertex-major stride; Box2D's
 //! `b2FloatW`). Each lane runs exactly the per-node functions of the per-strand path
-//! ([`super::project_node`], [`collisions`], [`Chain::advance`], [`velocity::finish`]) in the
+//! ([`super::advance`], [`super::collisions::push_out`], [`super::velocity::finish`]) in the
 //! same order, written once on lanes ([`super::lane`]): with `T = Wide<W>` every operation is
 //! a loop over `[Real; W]` with no cross-lane term, which the compiler turns into packed
 //! instructions (no `core::simd`, no unsafe), and both paths give the same bits.
