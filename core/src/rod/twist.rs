@@ -53,6 +53,7 @@ const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
 /// and `j + 1` in the Bishop frame of segment `j` (Kmoch Sec. 6.2), averaged as lines:
 /// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
 /// doubled angle is a complex square, the half angle a square root.
+#[inline(always)]
 #[must_use]
 pub fn binormal_direction<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
@@ -95,6 +96,7 @@ pub fn binormal_direction<P: Precision, const N: usize>(
 /// The bending energy of nodes `j`, `j + 1` in frame `j` at `θ` and at `θ ± π`:
 /// `Σ_i ½(1/l̂_i)(±ω − ω̂)ᵀB(±ω − ω̂)`, since `ω(θ ± π) = −ω(θ)`. Each is summed as squares
 /// (not expanded), so near rest the comparison is not lost to cancellation.
+#[inline(always)]
 fn local_bending<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
