@@ -5,10 +5,13 @@
 //! Each particle's cell comes from its sorted position; the nine rows around it
 //! ([`RowsAround`]) are hashed once per run of particles in one row, and the 27 cells are read
 //! as nine ranges of three cells (more where the row crosses into the next brick) of the
-//! sorted structure-of-arrays positions, gathered once per cell (the sorted particles of a cell
-//! are consecutive and share them: on Mannequin A 71 % of particles gather, and sharing cut
-//! the search by ~13 %). The candidates are tested eight at a
-//! time for `r² < h²` (no square root), and the first `cap` that pass (and are not the
+//! sorted structure-of-arrays positions, looked up once per cell (the sorted particles of a
+//! cell are consecutive). Each range is tested where it lies, four candidates at a time for
+//! `r² < h²` (no square root; one packed compare on x86-64), a short range as two blocks with
+//! no branch on its length, and the hits of several ranges are taken from one mask
+//! ([`test_ranges`]). Session 4 copied the candidates into one run first; testing in place
+//! with the mask took the search from 75 to 64 ms on Mannequin A, one thread, with the same
+//! lists. The first `cap` hits (that are not the
 //! particle itself nor its own strand's near nodes) are kept, in scan order. The order is a
 //! function of the positions only, so lists, truncation and every sum over a list are the
 //! same on any number of threads.
@@ -23,12 +26,12 @@ use super::forces::{poly6_factor, SortedParticles};
 use super::grid::{cell_of, Grid, RowsAround, MAX_RANGES};
 use super::{SphParams, CHUNK};
 
-/// Entries past the last particle in the position arrays: a range is copied as this many
-/// candidates whatever its length.
+/// Entries past the last particle in the position arrays: a short range is tested as
+/// [`SHORT`] candidates whatever its length (at least that many).
 pub const PADDING: usize = 16;
 
-/// Lanes of the distance test.
-const LANES: usize = 8;
+/// Lanes of the distance test: one SSE register on the x86-64 baseline.
+const LANES: usize = 4;
 
 /// Bits of a particle's key holding its node index; the strand is above them.
 pub const NODE_BITS: u32 = 8;
@@ -121,10 +124,9 @@ impl NeighbourLists {
                 let mut found = Found::default();
                 let mut rows = RowsAround::NONE;
                 let mut ranges = [(0u32, 0u32); MAX_RANGES];
-                let mut candidates = Candidates::new();
-                // The cell whose 27 cells `candidates` holds, all of them: sorted particles of
-                // one cell are consecutive and share their candidates.
-                let mut gathered: Option<[i32; 3]> = None;
+                // The cell whose 27 cells `ranges` holds: sorted particles of one cell are
+                // consecutive and share them.
+                let mut ranged: Option<([i32; 3], usize)> = None;
                 let mut used = 0usize;
                 for k in 0..count.len() {
                     let a = c * CHUNK + k;
@@ -152,17 +154,15 @@ impl NeighbourLists {
                         kept += usize::from(keep);
                         all += u32::from(neighbour);
                     };
-                    if gathered != Some(cell) {
-                        let m = rows.ranges(grid, cell, &mut ranges);
-                        candidates.clear();
-                        for &(s, e) in &ranges[..m] {
-                            candidates.take(s as usize, e as usize, (x, y, z), me, h2, &mut hit);
+                    let m = match ranged {
+                        Some((of, m)) if of == cell => m,
+                        _ => {
+                            let m = rows.ranges(grid, cell, &mut ranges);
+                            ranged = Some((cell, m));
+                            m
                         }
-                        // More than the buffer holds was tested in turns for this particle
-                        // and let go: the next particle of the cell gathers again.
-                        gathered = (!candidates.flushed).then_some(cell);
-                    }
-                    candidates.test(me, h2, &mut hit);
+                    };
+                    test_ranges(&ranges[..m], (x, y, z), me, h2, &mut hit);
                     start[k] = (c * (CHUNK * cap + 1) + used) as u32;
                     count[k] = kept as u32;
                     used += kept;
@@ -188,168 +188,165 @@ fn near_on_strand(a: u32, b: u32, gap: u32) -> bool {
     ((a >> NODE_BITS) == (b >> NODE_BITS)) & ((a & node).abs_diff(b & node) <= gap)
 }
 
-/// Candidates held for one distance test: room for this many (most particles have a few
-/// dozen; more are tested in turns). One bit each in the test's mask.
-const ROOM: usize = 128;
+/// Ranges whose hits are collected in one mask, [`SHORT`] bits each.
+const GROUP: usize = 8;
 
-/// The candidates of one particle, gathered from its ranges into one contiguous run so that
-/// the distance test runs over them in full blocks of eight, not a part-filled block per
-/// range. A range of at most [`PADDING`] is copied as that many whatever its length (no
-/// branch on the length; the lanes past it are overwritten by the next range or masked off).
-struct Candidates {
-    x: [f32; ROOM + PADDING],
-    y: [f32; ROOM + PADDING],
-    z: [f32; ROOM + PADDING],
-    index: [u32; ROOM + PADDING],
-    d2: [f32; ROOM + PADDING],
-    len: usize,
-    /// Whether candidates were tested and dropped since [`Candidates::clear`] (more than
-    /// [`ROOM`]): then the buffer no longer holds them all.
-    flushed: bool,
-}
+/// A range of at most this many particles is tested as two blocks whatever its length.
+const SHORT: usize = 2 * LANES;
 
-/// The sorted indices `0 .. PADDING`, added to a range's start.
-const STEPS: [u32; PADDING] = {
-    let mut steps = [0; PADDING];
-    let mut l = 0;
-    while l < PADDING {
-        steps[l] = l as u32;
-        l += 1;
-    }
-    steps
-};
+const _: () = assert!(PADDING >= SHORT && GROUP * SHORT <= 64);
 
-impl Candidates {
-    fn new() -> Candidates {
-        Candidates {
-            x: [0.0; ROOM + PADDING],
-            y: [0.0; ROOM + PADDING],
-            z: [0.0; ROOM + PADDING],
-            index: [0; ROOM + PADDING],
-            d2: [0.0; ROOM + PADDING],
-            len: 0,
-            flushed: false,
-        }
-    }
-
-    fn clear(&mut self) {
-        self.len = 0;
-        self.flushed = false;
-    }
-
-    /// Appends sorted particles `s .. e`, testing what is held first when there is no room.
-    #[inline(always)]
-    fn take(
-        &mut self,
-        s: usize,
-        e: usize,
-        xyz: (&[f32], &[f32], &[f32]),
-        me: [f32; 3],
-        h2: f32,
-        hit: &mut impl FnMut(usize, f32),
-    ) {
-        let len = e.saturating_sub(s);
-        if len <= PADDING && self.len + PADDING <= ROOM {
-            self.copy(s, xyz);
-            self.len += len;
-        } else {
-            self.take_long(s, e, xyz, me, h2, hit);
-        }
-    }
-
-    /// [`Candidates::take`] for a long range or a full buffer.
-    #[inline(never)]
-    fn take_long(
-        &mut self,
-        mut s: usize,
-        e: usize,
-        xyz: (&[f32], &[f32], &[f32]),
-        me: [f32; 3],
-        h2: f32,
-        hit: &mut impl FnMut(usize, f32),
-    ) {
-        while s < e {
-            if self.len + PADDING > ROOM {
-                self.test(me, h2, hit);
-                self.len = 0;
-                self.flushed = true;
-            }
-            self.copy(s, xyz);
-            let taken = (e - s).min(PADDING);
-            self.len += taken;
-            s += taken;
-        }
-    }
-
-    /// Copies sorted particles `s .. s + PADDING` to the end of the held ones (not counted).
-    /// Both ends have the room: the position arrays [`PADDING`] past the last particle, the
-    /// buffer [`PADDING`] past [`ROOM`].
-    #[inline(always)]
-    fn copy(&mut self, s: usize, (x, y, z): (&[f32], &[f32], &[f32])) {
-        let at = self.len;
-        self.x[at..at + PADDING].copy_from_slice(&x[s..s + PADDING]);
-        self.y[at..at + PADDING].copy_from_slice(&y[s..s + PADDING]);
-        self.z[at..at + PADDING].copy_from_slice(&z[s..s + PADDING]);
-        let first = s as u32;
-        // On a fixed-size array, so that it is four vector adds, not sixteen scalar ones.
-        if let Ok(index) = <&mut [u32; PADDING]>::try_from(&mut self.index[at..at + PADDING]) {
-            for (i, l) in index.iter_mut().zip(STEPS) {
-                *i = first + l;
-            }
-        }
-    }
-
-    /// Calls `hit(j, r²)` for every held candidate `j` with `r² < h2`, in order. The
-    /// distance test runs on blocks of eight (vectorised) into one mask for all of them;
-    /// then one loop over its set bits calls `hit`.
-    #[inline(always)]
-    fn test(&mut self, me: [f32; 3], h2: f32, hit: &mut impl FnMut(usize, f32)) {
-        let blocks = self.len.div_ceil(LANES);
-        let mut mask = 0u128;
-        for (b, (((bx, by), bz), d2)) in self
-            .x
-            .chunks_exact(LANES)
-            .zip(self.y.chunks_exact(LANES))
-            .zip(self.z.chunks_exact(LANES))
-            .zip(self.d2.chunks_exact_mut(LANES))
-            .take(blocks)
-            .enumerate()
-        {
-            let (Ok(bx), Ok(by), Ok(bz)) = (bx.try_into(), by.try_into(), bz.try_into()) else {
-                continue;
-            };
-            // Into a local array first: stores into `self.d2` between the loads of
-            // `self.x` would keep the compiler from vectorising.
-            let (bits, r2) = block(bx, by, bz, me, h2);
-            d2.copy_from_slice(&r2);
-            mask |= u128::from(bits) << (b * LANES);
-        }
-        if self.len < ROOM {
-            mask &= (1u128 << self.len) - 1;
-        }
-        while mask != 0 {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            hit(self.index[i] as usize, self.d2[i]);
-        }
-    }
-}
-
-/// A bit per candidate with `r² < h2`, and `r²` from `me` to eight candidates.
+/// Calls `hit(j, r²)` for every sorted particle `j` of `ranges` with `r² < h2`, in order
+/// (range by range, each in sorted order), testing them where they lie. A short range (most:
+/// a range holds about five particles on a head) is tested as two blocks of [`LANES`] with
+/// the lanes past its end masked off — the position arrays have [`PADDING`] entries past the
+/// last particle — and its hits go into one mask with those of up to [`GROUP`] ranges, so
+/// that neither a range's length nor its hits cost a branch of their own; the few hits are
+/// then taken from the mask in one loop.
 #[inline(always)]
-fn block(
-    x: &[f32; LANES],
-    y: &[f32; LANES],
-    z: &[f32; LANES],
-    [xa, ya, za]: [f32; 3],
+fn test_ranges(
+    ranges: &[(u32, u32)],
+    xyz: (&[f32], &[f32], &[f32]),
+    me: [f32; 3],
     h2: f32,
-) -> (u32, [f32; LANES]) {
-    let mut d2 = [0.0; LANES];
-    let mut bits = [0u32; LANES];
-    for l in 0..LANES {
-        let (dx, dy, dz) = (xa - x[l], ya - y[l], za - z[l]);
-        d2[l] = dx * dx + dy * dy + dz * dz;
-        bits[l] = if d2[l] < h2 { 1 << l } else { 0 };
+    hit: &mut impl FnMut(usize, f32),
+) {
+    let (x, y, z) = xyz;
+    let mut mask = 0u64;
+    let mut starts = [0usize; GROUP];
+    let mut held = 0;
+    for &(s, e) in ranges {
+        let (s, e) = (s as usize, e.max(s) as usize);
+        if e - s > SHORT || held == GROUP {
+            take_hits(&mut mask, &starts, xyz, me, hit);
+            held = 0;
+        }
+        if e - s > SHORT {
+            test_range(s, e, xyz, me, h2, hit);
+            continue;
+        }
+        let (Some(x0), Some(y0), Some(z0), Some(x1), Some(y1), Some(z1)) = (
+            lanes(x, s),
+            lanes(y, s),
+            lanes(z, s),
+            lanes(x, s + LANES),
+            lanes(y, s + LANES),
+            lanes(z, s + LANES),
+        ) else {
+            continue;
+        };
+        let bits = (within(x0, y0, z0, me, h2) | within(x1, y1, z1, me, h2) << LANES)
+            & ((1 << (e - s)) - 1);
+        mask |= u64::from(bits) << (held * SHORT);
+        starts[held] = s;
+        held += 1;
     }
-    (bits.iter().fold(0, |m, &b| m | b), d2)
+    take_hits(&mut mask, &starts, xyz, me, hit);
+}
+
+/// Calls `hit` for each set bit of `mask` (bit `SHORT · g + l`: particle `starts[g] + l`), in
+/// bit order, and clears the mask.
+#[inline(always)]
+fn take_hits(
+    mask: &mut u64,
+    starts: &[usize; GROUP],
+    (x, y, z): (&[f32], &[f32], &[f32]),
+    me: [f32; 3],
+    hit: &mut impl FnMut(usize, f32),
+) {
+    while *mask != 0 {
+        let bit = mask.trailing_zeros() as usize;
+        *mask &= *mask - 1;
+        let j = starts[bit / SHORT] + bit % SHORT;
+        let (Some(&xj), Some(&yj), Some(&zj)) = (x.get(j), y.get(j), z.get(j)) else {
+            continue;
+        };
+        hit(j, distance_squared(me, [xj, yj, zj]));
+    }
+}
+
+/// Calls `hit(j, r²)` for every sorted particle `j` in `s .. e` with `r² < h2`, in order,
+/// testing them where they lie, [`LANES`] at a time (the position arrays have [`PADDING`]
+/// entries past the last particle, so a block may run past `e`; its extra lanes are masked
+/// off). A range holds about five particles on a head: mostly two blocks.
+#[inline(always)]
+fn test_range(
+    s: usize,
+    e: usize,
+    (x, y, z): (&[f32], &[f32], &[f32]),
+    me: [f32; 3],
+    h2: f32,
+    hit: &mut impl FnMut(usize, f32),
+) {
+    let mut at = s;
+    while at < e {
+        let (Some(bx), Some(by), Some(bz)) = (lanes(x, at), lanes(y, at), lanes(z, at)) else {
+            return;
+        };
+        let mut bits = within(bx, by, bz, me, h2);
+        if e - at < LANES {
+            bits &= (1 << (e - at)) - 1;
+        }
+        while bits != 0 {
+            let l = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            hit(at + l, distance_squared(me, [bx[l], by[l], bz[l]]));
+        }
+        at += LANES;
+    }
+}
+
+/// The `LANES` entries of `v` from `at`.
+#[inline(always)]
+fn lanes(v: &[f32], at: usize) -> Option<&[f32; LANES]> {
+    v.get(at..at + LANES)?.try_into().ok()
+}
+
+/// `|a − b|²`, summed as `(dx² + dy²) + dz²` — the order of [`within`] and of the brute-force
+/// reference.
+#[inline(always)]
+fn distance_squared([xa, ya, za]: [f32; 3], [x, y, z]: [f32; 3]) -> f32 {
+    let (dx, dy, dz) = (xa - x, ya - y, za - z);
+    dx * dx + dy * dy + dz * dz
+}
+
+/// A bit per candidate with `r² < h2`, from `me` to four candidates, with the bits of
+/// [`distance_squared`]. On x86-64, one packed subtract, multiply and add per axis, a packed
+/// compare and its sign mask (`movmskps`): written lane by lane, LLVM's vectoriser pairs the
+/// axes of one lane instead of the lanes of one axis and shuffles (≈ 3× the instructions).
+#[inline(always)]
+fn within(x: &[f32; LANES], y: &[f32; LANES], z: &[f32; LANES], me: [f32; 3], h2: f32) -> u32 {
+    #[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+    // SAFETY: `within_sse2` needs SSE2, which this build has (the cfg above: x86-64's
+    // baseline); it reads only its arguments.
+    unsafe {
+        within_sse2(x, y, z, me, h2)
+    }
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
+    {
+        let mut bits = 0;
+        for l in 0..LANES {
+            bits |= u32::from(distance_squared(me, [x[l], y[l], z[l]]) < h2) << l;
+        }
+        bits
+    }
+}
+
+/// [`within`] in SSE2: each operation is the IEEE single-precision one of the scalar form,
+/// in the same order, so the mask is the same bit for bit.
+#[cfg(all(target_arch = "x86_64", target_feature = "sse2"))]
+#[target_feature(enable = "sse2")]
+fn within_sse2(x: &[f32; LANES], y: &[f32; LANES], z: &[f32; LANES], me: [f32; 3], h2: f32) -> u32 {
+    use core::arch::x86_64::{
+        _mm_add_ps, _mm_cmplt_ps, _mm_movemask_ps, _mm_mul_ps, _mm_set1_ps, _mm_setr_ps, _mm_sub_ps,
+    };
+    let squared = |v: &[f32; LANES], m: f32| {
+        let d = _mm_sub_ps(_mm_set1_ps(m), _mm_setr_ps(v[0], v[1], v[2], v[3]));
+        _mm_mul_ps(d, d)
+    };
+    let d2 = _mm_add_ps(
+        _mm_add_ps(squared(x, me[0]), squared(y, me[1])),
+        squared(z, me[2]),
+    );
+    _mm_movemask_ps(_mm_cmplt_ps(d2, _mm_set1_ps(h2))) as u32
 }
