@@ -323,13 +323,24 @@ fn within(x: &[f32; LANES], y: &[f32; LANES], z: &[f32; LANES], me: [f32; 3], h2
         within_sse2(x, y, z, me, h2)
     }
     #[cfg(not(all(target_arch = "x86_64", target_feature = "sse2")))]
-    {
-        let mut bits = 0;
-        for l in 0..LANES {
-            bits |= u32::from(distance_squared(me, [x[l], y[l], z[l]]) < h2) << l;
-        }
-        bits
+    within_scalar(x, y, z, me, h2)
+}
+
+/// [`within`] lane by lane.
+#[inline(always)]
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "sse2"), allow(dead_code))]
+fn within_scalar(
+    x: &[f32; LANES],
+    y: &[f32; LANES],
+    z: &[f32; LANES],
+    me: [f32; 3],
+    h2: f32,
+) -> u32 {
+    let mut bits = 0;
+    for l in 0..LANES {
+        bits |= u32::from(distance_squared(me, [x[l], y[l], z[l]]) < h2) << l;
     }
+    bits
 }
 
 /// [`within`] in SSE2: each operation is the IEEE single-precision one of the scalar form,
@@ -349,4 +360,46 @@ fn within_sse2(x: &[f32; LANES], y: &[f32; LANES], z: &[f32; LANES], me: [f32; 3
         squared(z, me[2]),
     );
     _mm_movemask_ps(_mm_cmplt_ps(d2, _mm_set1_ps(h2))) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_packed_distance_test_is_the_scalar_one_bit_for_bit() {
+        let mut state = 0x9e37_79b9u32;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            (state as f32 / u32::MAX as f32) * 0.02 - 0.01
+        };
+        let h2 = 0.0045f32 * 0.0045;
+        let mut hits = 0;
+        for round in 0..20_000 {
+            let me = [next(), next(), next()];
+            let mut v = [[0.0f32; LANES]; 3];
+            for axis in &mut v {
+                for c in axis.iter_mut() {
+                    *c = next();
+                }
+            }
+            // Edge cases: a candidate exactly at `h`, at the particle, and not finite.
+            match round % 4 {
+                0 => v[0][0] = me[0] + 0.0045,
+                1 => [v[0][1], v[1][1], v[2][1]] = me,
+                2 => v[1][2] = f32::NAN,
+                _ => v[2][3] = f32::INFINITY,
+            }
+            let packed = within(&v[0], &v[1], &v[2], me, h2);
+            assert_eq!(
+                packed,
+                within_scalar(&v[0], &v[1], &v[2], me, h2),
+                "{me:?} {v:?}"
+            );
+            hits += packed.count_ones();
+        }
+        assert!(hits > 1_000, "the test should see hits: {hits}");
+    }
 }
