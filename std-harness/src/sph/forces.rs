@@ -26,7 +26,7 @@ use rayon::prelude::*;
 use super::neighbours::{NeighbourLists, PADDING};
 use super::{SphParams, CHUNK};
 
-/// What the counting sort moves for each particle: 32 bytes, one write per particle.
+/// What the hash pass reads of each particle (32 bytes), gathered into the sorted order.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Record {
     /// Position, m.
@@ -42,8 +42,8 @@ pub struct Record {
 /// Particles rearranged into the grid's sorted order, and what is computed for them.
 #[derive(Clone, Debug, Default)]
 pub struct SortedParticles {
-    /// The sorted records.
-    pub record: Vec<Record>,
+    /// Velocities, m/s.
+    pub velocity: Vec<[f32; 3]>,
     /// Positions, m: x (and [`PADDING`] entries past the last particle, never a neighbour).
     pub x: Vec<f32>,
     /// Positions, m: y.
@@ -67,7 +67,7 @@ impl SortedParticles {
     #[must_use]
     pub fn new(n: usize) -> SortedParticles {
         SortedParticles {
-            record: vec![Record::default(); n],
+            velocity: vec![[0.0; 3]; n],
             x: vec![0.0; n + PADDING],
             y: vec![0.0; n + PADDING],
             z: vec![0.0; n + PADDING],
@@ -85,23 +85,28 @@ impl SortedParticles {
         Vec3::new(self.x[k], self.y[k], self.z[k])
     }
 
-    /// Fills the structure-of-arrays positions, masses and keys from the sorted records.
-    pub fn split(&mut self) {
-        let n = self.record.len();
-        let record = &self.record;
+    /// Fills the sorted arrays: sorted particle `k` is `record[order[k]]` (Algorithm 1
+    /// line 5), chunk by chunk in parallel — each record read once, each array written in
+    /// order.
+    pub fn gather(&mut self, order: &[u32], record: &[Record]) {
+        let n = order.len().min(self.velocity.len());
         (
             self.x[..n].par_chunks_mut(CHUNK),
             self.y[..n].par_chunks_mut(CHUNK),
             self.z[..n].par_chunks_mut(CHUNK),
-            self.mass.par_chunks_mut(CHUNK),
-            self.key.par_chunks_mut(CHUNK),
+            self.velocity[..n].par_chunks_mut(CHUNK),
+            self.mass[..n].par_chunks_mut(CHUNK),
+            self.key[..n].par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
-            .for_each(|(c, (x, y, z, m, key))| {
-                for (k, r) in record[c * CHUNK..].iter().take(x.len()).enumerate() {
+            .for_each(|(c, (x, y, z, v, m, key))| {
+                for (k, &p) in order[c * CHUNK..].iter().take(x.len()).enumerate() {
+                    let Some(r) = record.get(p as usize) else {
+                        continue;
+                    };
                     [x[k], y[k], z[k]] = r.position;
-                    (m[k], key[k]) = (r.mass, r.key);
+                    (v[k], m[k], key[k]) = (r.velocity, r.mass, r.key);
                 }
             });
     }

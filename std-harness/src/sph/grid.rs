@@ -11,6 +11,7 @@
 //! (rows collide); the neighbour search filters by distance.
 
 use hairsim_core::Vec3;
+use rayon::prelude::*;
 
 /// Buckets in a row (consecutive cells along x).
 pub const ROW: u32 = 16;
@@ -68,16 +69,37 @@ pub fn bucket_of(cell: [i32; 3], row_mask: u32) -> u32 {
     row_of(cell[0], cell[1], cell[2], row_mask) * ROW + (cell[0] as u32 & (ROW - 1))
 }
 
+/// Parts of the bucket range the counting sort's second pass sorts side by side.
+const PARTS: usize = 64;
+
+/// Particles per work item of the counting sort's first and last passes (a constant of the
+/// code, never derived from the thread count).
+const SORT_CHUNK: usize = 8192;
+
 /// The grid: the counting sort's output and its scratch.
 #[derive(Clone, Debug)]
 pub struct Grid {
     inverse_cell: f32,
     row_mask: u32,
+    /// `bucket >> part_shift` is the bucket's part.
+    part_shift: u32,
     /// `bucket_start[b] .. bucket_start[b + 1]` are bucket `b`'s particles in sorted order
-    /// (one entry more, the counting sort's scratch).
+    /// (and one entry more).
     pub bucket_start: Vec<u32>,
     /// Particle `p` is at sorted position `rank[p]`.
     pub rank: Vec<u32>,
+    /// Sorted position `k` holds particle `order[k]`.
+    pub order: Vec<u32>,
+    /// Each sort chunk's `(bucket, particle)`s grouped by part, in particle order.
+    staged: Vec<(u32, u32)>,
+    /// Where each part starts in its chunk's `staged` (and the chunk's length).
+    chunk_parts: Vec<[u32; PARTS + 1]>,
+    /// Where each chunk's particles of each part start in the part-major order.
+    part_chunk_start: Vec<[u32; PARTS]>,
+    /// The sorted position of each particle in the part-major order.
+    placed: Vec<u32>,
+    /// Per bucket, the next free sorted position while placing.
+    cursor: Vec<u32>,
 }
 
 impl Grid {
@@ -87,11 +109,19 @@ impl Grid {
     pub fn new(particles: usize, h: f32) -> Grid {
         let rows = (particles.next_power_of_two() / ROW as usize).max(16);
         let buckets = rows * ROW as usize;
+        let chunks = particles.div_ceil(SORT_CHUNK);
         Grid {
             inverse_cell: 1.0 / h,
             row_mask: (rows - 1) as u32,
+            part_shift: (buckets / PARTS).trailing_zeros(),
             bucket_start: vec![0; buckets + 2],
             rank: vec![0; particles],
+            order: vec![0; particles],
+            staged: vec![(0, 0); particles],
+            chunk_parts: vec![[0; PARTS + 1]; chunks],
+            part_chunk_start: vec![[0; PARTS]; chunks],
+            placed: vec![0; particles],
+            cursor: vec![0; buckets],
         }
     }
 
@@ -107,36 +137,105 @@ impl Grid {
         self.row_mask
     }
 
-    /// Sorts particles `0 .. bucket.len()` by their buckets and moves each one's `record`
-    /// to its sorted place (`sorted[rank[p]] = record[p]`). Stable: within a bucket
+    /// Sorts particles `0 .. bucket.len()` by their buckets: `order` (sorted position to
+    /// particle), `rank` (its inverse) and the buckets' starts. Stable: within a bucket
     /// particles keep their index order — so the order, and every sum taken in it, is a
-    /// function of the positions alone. One pass to count, one to place: the records are
-    /// read in order and each written once (no second, random-read gather).
-    pub fn sort<T: Copy>(&mut self, bucket: &[u32], record: &[T], sorted: &mut [T]) {
-        // `bucket_start[b + 1]` counts bucket `b`, then (prefix sums) is where it starts,
-        // then (each placement moves it on) where it ends: the start of bucket `b + 1`.
-        let starts = &mut self.bucket_start;
-        starts.fill(0);
-        for &b in bucket {
-            if let Some(count) = starts.get_mut(b as usize + 2) {
-                *count += 1;
+    /// function of the positions alone.
+    ///
+    /// In parallel, with every split fixed by the scene (never by the thread count):
+    /// 1. each chunk of [`SORT_CHUNK`] particles groups its particles by *part* (a 64th of the
+    ///    bucket range) in its own piece of `staged`, stably;
+    /// 2. each part counts its buckets, places its particles (chunk by chunk, so still in
+    ///    particle order) into its own range of `order`, and sets its own buckets' starts;
+    /// 3. each chunk reads back where its particles went, into its own piece of `rank`.
+    ///
+    /// Every write of a pass lands in a range that pass's work item owns, so the result is
+    /// the serial sort's on any number of threads.
+    pub fn sort(&mut self, bucket: &[u32]) {
+        let n = bucket.len().min(self.rank.len());
+        let buckets = self.buckets();
+        let shift = self.part_shift;
+        let part = |b: u32| ((b >> shift) as usize).min(PARTS - 1);
+        // 1. Group by part within each chunk.
+        self.staged[..n]
+            .par_chunks_mut(SORT_CHUNK)
+            .zip(self.chunk_parts.par_iter_mut())
+            .enumerate()
+            .for_each(|(c, (staged, parts))| {
+                let first = c * SORT_CHUNK;
+                let mine = &bucket[first..first + staged.len()];
+                let mut start = [0u32; PARTS + 1];
+                for &b in mine {
+                    start[part(b) + 1] += 1;
+                }
+                for p in 0..PARTS {
+                    start[p + 1] += start[p];
+                }
+                *parts = start;
+                for (k, &b) in mine.iter().enumerate() {
+                    let slot = &mut start[part(b)];
+                    if let Some(s) = staged.get_mut(*slot as usize) {
+                        *s = (b, (first + k) as u32);
+                    }
+                    *slot += 1;
+                }
+            });
+        // Where each part, and each chunk's share of it, starts in the sorted order.
+        let chunks = n.div_ceil(SORT_CHUNK);
+        let mut part_start = [0u32; PARTS + 1];
+        for p in 0..PARTS {
+            let mut at = part_start[p];
+            for (parts, starts) in self.chunk_parts[..chunks]
+                .iter()
+                .zip(&mut self.part_chunk_start)
+            {
+                starts[p] = at;
+                at += parts[p + 1] - parts[p];
             }
+            part_start[p + 1] = at;
         }
-        let mut sum = 0;
-        for start in starts.iter_mut() {
-            sum += *start;
-            *start = sum;
-        }
-        for ((&b, rank), r) in bucket.iter().zip(&mut self.rank).zip(record) {
-            let Some(cursor) = starts.get_mut(b as usize + 1) else {
-                continue;
-            };
-            *rank = *cursor;
-            if let Some(slot) = sorted.get_mut(*cursor as usize) {
-                *slot = *r;
-            }
-            *cursor += 1;
-        }
+        // 2. Each part sorts its particles by bucket.
+        let per_part = buckets / PARTS;
+        let shared = Shared {
+            staged: &self.staged,
+            chunk_parts: &self.chunk_parts[..chunks],
+            part_start: &part_start,
+            per_part,
+        };
+        sort_parts(
+            &shared,
+            0..PARTS,
+            &mut self.order[..n],
+            &mut self.bucket_start[..buckets],
+            &mut self.cursor[..buckets],
+            &mut self.placed[..n],
+        );
+        self.bucket_start[buckets] = n as u32;
+        self.bucket_start[buckets + 1] = n as u32;
+        // 3. Each chunk's ranks.
+        let (staged, placed) = (&self.staged, &self.placed);
+        self.rank[..n]
+            .par_chunks_mut(SORT_CHUNK)
+            .zip(self.chunk_parts.par_iter())
+            .zip(self.part_chunk_start.par_iter())
+            .enumerate()
+            .for_each(|(c, ((rank, parts), starts))| {
+                let first = c * SORT_CHUNK;
+                for p in 0..PARTS {
+                    let (s, e) = (parts[p] as usize, parts[p + 1] as usize);
+                    let from = starts[p] as usize;
+                    for (i, j) in (s..e).zip(from..) {
+                        let (Some(&(_, particle)), Some(&k)) =
+                            (staged.get(first + i), placed.get(j))
+                        else {
+                            continue;
+                        };
+                        if let Some(r) = rank.get_mut((particle as usize).wrapping_sub(first)) {
+                            *r = k;
+                        }
+                    }
+                }
+            });
     }
 
     /// The sorted range of the particles in buckets `first ..= last`.
@@ -154,6 +253,96 @@ impl Grid {
     #[must_use]
     pub fn buckets(&self) -> usize {
         self.bucket_start.len() - 2
+    }
+}
+
+/// What every part of the sort's second pass reads.
+struct Shared<'a> {
+    staged: &'a [(u32, u32)],
+    chunk_parts: &'a [[u32; PARTS + 1]],
+    part_start: &'a [u32; PARTS + 1],
+    per_part: usize,
+}
+
+/// The second pass for `parts`, whose sorted particles, bucket starts, cursors and part-major
+/// positions are the slices given: halves side by side until one part is left.
+fn sort_parts(
+    shared: &Shared<'_>,
+    parts: core::ops::Range<usize>,
+    sorted: &mut [u32],
+    starts: &mut [u32],
+    cursor: &mut [u32],
+    placed: &mut [u32],
+) {
+    if parts.len() > 1 {
+        let mid = parts.start + parts.len() / 2;
+        let at = (shared.part_start[mid] - shared.part_start[parts.start]) as usize;
+        let buckets = (mid - parts.start) * shared.per_part;
+        let (sorted_a, sorted_b) = sorted.split_at_mut(at.min(sorted.len()));
+        let (starts_a, starts_b) = starts.split_at_mut(buckets.min(starts.len()));
+        let (cursor_a, cursor_b) = cursor.split_at_mut(buckets.min(cursor.len()));
+        let (placed_a, placed_b) = placed.split_at_mut(at.min(placed.len()));
+        rayon::join(
+            || {
+                sort_parts(
+                    shared,
+                    parts.start..mid,
+                    sorted_a,
+                    starts_a,
+                    cursor_a,
+                    placed_a,
+                )
+            },
+            || {
+                sort_parts(
+                    shared,
+                    mid..parts.end,
+                    sorted_b,
+                    starts_b,
+                    cursor_b,
+                    placed_b,
+                )
+            },
+        );
+        return;
+    }
+    let p = parts.start;
+    let base = (p * shared.per_part) as u32;
+    let offset = shared.part_start[p];
+    // This part's particles, chunk by chunk: particle order.
+    let mine = || {
+        shared
+            .chunk_parts
+            .iter()
+            .enumerate()
+            .flat_map(move |(c, at)| {
+                let first = c * SORT_CHUNK;
+                let (s, e) = (first + at[p] as usize, first + at[p + 1] as usize);
+                shared.staged.get(s..e).unwrap_or(&[])
+            })
+    };
+    cursor.fill(0);
+    for &(b, _) in mine() {
+        if let Some(count) = cursor.get_mut(b.wrapping_sub(base) as usize) {
+            *count += 1;
+        }
+    }
+    let mut sum = offset;
+    for (start, count) in starts.iter_mut().zip(cursor.iter_mut()) {
+        *start = sum;
+        sum += *count;
+        *count = *start;
+    }
+    for (&(b, particle), place) in mine().zip(placed.iter_mut()) {
+        let Some(next) = cursor.get_mut(b.wrapping_sub(base) as usize) else {
+            continue;
+        };
+        let k = *next;
+        *next += 1;
+        *place = k;
+        if let Some(slot) = sorted.get_mut(k.wrapping_sub(offset) as usize) {
+            *slot = particle;
+        }
     }
 }
 
@@ -272,9 +461,8 @@ mod tests {
             .iter()
             .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.row_mask()))
             .collect();
-        let index: Vec<u32> = (0..points.len() as u32).collect();
-        let mut order = vec![u32::MAX; points.len()];
-        grid.sort(&bucket, &index, &mut order);
+        grid.sort(&bucket);
+        let order = grid.order.clone();
         let mut seen = vec![false; points.len()];
         for b in 0..grid.buckets() {
             let range = grid.bucket_start[b] as usize..grid.bucket_start[b + 1] as usize;
@@ -323,9 +511,8 @@ mod tests {
                 .iter()
                 .map(|&p| bucket_of(cell_of(p, 1.0), grid.row_mask()))
                 .collect();
-            let index: Vec<u32> = (0..points.len() as u32).collect();
-            let mut order = vec![0; points.len()];
-            grid.sort(&bucket, &index, &mut order);
+            grid.sort(&bucket);
+            let order = &grid.order;
             let mut rows = RowsAround::NONE;
             // Rows computed for another cell of the same row, then reused.
             rows.update([centre[0] & !15, centre[1], centre[2]], grid.row_mask());

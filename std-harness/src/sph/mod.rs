@@ -4,8 +4,8 @@
 //! Particles are the strand nodes. Each step:
 //! 1. [`grid`] hashes every node into cells the size of the smoothing length `h` and sorts them
 //!    by bucket with a **stable counting sort** (Algorithm 1 lines 2–4);
-//! 2. positions, velocities and masses are rearranged into that order (line 5), moved by the
-//!    sort itself as one 32-byte record per particle;
+//! 2. positions, velocities and masses are rearranged into that order (line 5): each sorted
+//!    particle's 32-byte record read once, in parallel over chunks of the sorted order;
 //! 3. [`neighbours`] builds a capped neighbour list per node (the paper's rough k-nearest list,
 //!    line 6) and, in the same pass, density (poly6) and pressure (line 7);
 //! 4. [`forces`] computes the pressure (spiky gradient) and viscosity (viscosity Laplacian)
@@ -242,9 +242,8 @@ impl Sph {
         let t1 = Instant::now();
         // Lines 3–5: stable counting sort by bucket, each record moved to its sorted place;
         // then the positions, masses and keys as the search reads them.
-        self.grid
-            .sort(&self.bucket, &self.record, &mut self.sorted.record);
-        self.sorted.split();
+        self.grid.sort(&self.bucket);
+        self.sorted.gather(&self.grid.order, &self.record);
         let t2 = Instant::now();
         // Lines 6–7: capped neighbour lists, density and pressure.
         let found = self

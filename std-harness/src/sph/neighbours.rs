@@ -104,15 +104,15 @@ impl NeighbourLists {
             x,
             y,
             z,
-            record,
+            velocity,
             mass,
             key,
             density,
             packed,
             ..
         } = p;
-        let (x, y, z, mass, key, record) =
-            (&x[..], &y[..], &z[..], &mass[..], &key[..], &record[..]);
+        let (x, y, z, mass, key, velocity) =
+            (&x[..], &y[..], &z[..], &mass[..], &key[..], &velocity[..]);
         self.list
             .par_chunks_mut(CHUNK * cap + 1)
             .zip(self.start[..n].par_chunks_mut(CHUNK))
@@ -172,7 +172,7 @@ impl NeighbourLists {
                     let rho = c6 * sum;
                     let pr = (stiffness * (rho - rest)).max(0.0);
                     density[k] = rho;
-                    let [vx, vy, vz] = record[a].velocity;
+                    let [vx, vy, vz] = velocity[a];
                     packed[k] = [me[0], me[1], me[2], mass[a] / rho, vx, vy, vz, pr];
                 }
                 found
