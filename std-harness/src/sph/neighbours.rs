@@ -26,7 +26,7 @@ use super::forces::{poly6_factor, SortedParticles};
 use super::grid::{cell_of, Grid, RowsAround, MAX_RANGES};
 use super::{SphParams, CHUNK};
 
-/// Entries past the last particle in the position arrays: a short range is tested as
+/// Entries past the last particle in the position arrays: a range is tested in pieces of
 /// [`SHORT`] candidates whatever its length (at least that many).
 pub const PADDING: usize = 16;
 
@@ -188,21 +188,21 @@ fn near_on_strand(a: u32, b: u32, gap: u32) -> bool {
     ((a >> NODE_BITS) == (b >> NODE_BITS)) & ((a & node).abs_diff(b & node) <= gap)
 }
 
-/// Ranges whose hits are collected in one mask, [`SHORT`] bits each.
+/// Pieces of ranges whose hits are collected in one mask, [`SHORT`] bits each.
 const GROUP: usize = 8;
 
-/// A range of at most this many particles is tested as two blocks whatever its length.
+/// A range is tested in pieces of this many particles: two blocks, whatever its length.
 const SHORT: usize = 2 * LANES;
 
 const _: () = assert!(PADDING >= SHORT && GROUP * SHORT <= 64);
 
 /// Calls `hit(j, r²)` for every sorted particle `j` of `ranges` with `r² < h2`, in order
-/// (range by range, each in sorted order), testing them where they lie. A short range (most:
-/// a range holds about five particles on a head) is tested as two blocks of [`LANES`] with
-/// the lanes past its end masked off — the position arrays have [`PADDING`] entries past the
-/// last particle — and its hits go into one mask with those of up to [`GROUP`] ranges, so
-/// that neither a range's length nor its hits cost a branch of their own; the few hits are
-/// then taken from the mask in one loop.
+/// (range by range, each in sorted order), testing them where they lie. A range is tested in
+/// pieces of [`SHORT`] (most ranges are one piece: a range holds about five particles on a
+/// head), each as two blocks of [`LANES`] with the lanes past the range's end masked off — the
+/// position arrays have [`PADDING`] entries past the last particle — and the hits of up to
+/// [`GROUP`] pieces go into one mask, so that neither a range's length nor its hits cost a
+/// branch of their own; the few hits are then taken from the mask in one loop.
 #[inline(always)]
 fn test_ranges(
     ranges: &[(u32, u32)],
@@ -216,30 +216,29 @@ fn test_ranges(
     let mut starts = [0usize; GROUP];
     let mut held = 0;
     for &(s, e) in ranges {
-        let (s, e) = (s as usize, e.max(s) as usize);
-        if e - s > SHORT || held == GROUP {
-            take_hits(&mut mask, &starts, xyz, me, hit);
-            held = 0;
+        let (mut s, e) = (s as usize, e.max(s) as usize);
+        // Bounded: `s` moves on by SHORT a pass until it reaches `e`.
+        loop {
+            if held == GROUP {
+                take_hits(&mut mask, &starts, xyz, me, hit);
+                held = 0;
+            }
+            let mut bits = 0;
+            for block in 0..SHORT / LANES {
+                let at = s + block * LANES;
+                if let (Some(bx), Some(by), Some(bz)) = (lanes(x, at), lanes(y, at), lanes(z, at)) {
+                    bits |= within(bx, by, bz, me, h2) << (block * LANES);
+                }
+            }
+            bits &= (1 << (e - s).min(SHORT)) - 1;
+            mask |= u64::from(bits) << (held * SHORT);
+            starts[held] = s;
+            held += 1;
+            s += SHORT;
+            if s >= e {
+                break;
+            }
         }
-        if e - s > SHORT {
-            test_range(s, e, xyz, me, h2, hit);
-            continue;
-        }
-        let (Some(x0), Some(y0), Some(z0), Some(x1), Some(y1), Some(z1)) = (
-            lanes(x, s),
-            lanes(y, s),
-            lanes(z, s),
-            lanes(x, s + LANES),
-            lanes(y, s + LANES),
-            lanes(z, s + LANES),
-        ) else {
-            continue;
-        };
-        let bits = (within(x0, y0, z0, me, h2) | within(x1, y1, z1, me, h2) << LANES)
-            & ((1 << (e - s)) - 1);
-        mask |= u64::from(bits) << (held * SHORT);
-        starts[held] = s;
-        held += 1;
     }
     take_hits(&mut mask, &starts, xyz, me, hit);
 }
@@ -262,37 +261,6 @@ fn take_hits(
             continue;
         };
         hit(j, distance_squared(me, [xj, yj, zj]));
-    }
-}
-
-/// Calls `hit(j, r²)` for every sorted particle `j` in `s .. e` with `r² < h2`, in order,
-/// testing them where they lie, [`LANES`] at a time (the position arrays have [`PADDING`]
-/// entries past the last particle, so a block may run past `e`; its extra lanes are masked
-/// off). A range holds about five particles on a head: mostly two blocks.
-#[inline(always)]
-fn test_range(
-    s: usize,
-    e: usize,
-    (x, y, z): (&[f32], &[f32], &[f32]),
-    me: [f32; 3],
-    h2: f32,
-    hit: &mut impl FnMut(usize, f32),
-) {
-    let mut at = s;
-    while at < e {
-        let (Some(bx), Some(by), Some(bz)) = (lanes(x, at), lanes(y, at), lanes(z, at)) else {
-            return;
-        };
-        let mut bits = within(bx, by, bz, me, h2);
-        if e - at < LANES {
-            bits &= (1 << (e - at)) - 1;
-        }
-        while bits != 0 {
-            let l = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            hit(at + l, distance_squared(me, [bx[l], by[l], bz[l]]));
-        }
-        at += LANES;
     }
 }
 
