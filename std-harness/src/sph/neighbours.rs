@@ -188,13 +188,15 @@ fn near_on_strand(a: u32, b: u32, gap: u32) -> bool {
     ((a >> NODE_BITS) == (b >> NODE_BITS)) & ((a & node).abs_diff(b & node) <= gap)
 }
 
-/// Pieces of ranges whose hits are collected in one mask, [`SHORT`] bits each.
-const GROUP: usize = 8;
+/// Pieces of ranges whose hits are collected in one mask, [`SHORT`] bits each: the nine
+/// ranges of most particles and a few long ones, so that most particles take their hits in
+/// one loop.
+const GROUP: usize = 16;
 
 /// A range is tested in pieces of this many particles: two blocks, whatever its length.
 const SHORT: usize = 2 * LANES;
 
-const _: () = assert!(PADDING >= SHORT && GROUP * SHORT <= 64);
+const _: () = assert!(PADDING >= SHORT && GROUP * SHORT <= 128);
 
 /// Calls `hit(j, r²)` for every sorted particle `j` of `ranges` with `r² < h2`, in order
 /// (range by range, each in sorted order), testing them where they lie. A range is tested in
@@ -212,7 +214,7 @@ fn test_ranges(
     hit: &mut impl FnMut(usize, f32),
 ) {
     let (x, y, z) = xyz;
-    let mut mask = 0u64;
+    let mut mask = 0u128;
     let mut starts = [0usize; GROUP];
     let mut held = 0;
     for &(s, e) in ranges {
@@ -231,7 +233,7 @@ fn test_ranges(
                 }
             }
             bits &= (1 << (e - s).min(SHORT)) - 1;
-            mask |= u64::from(bits) << (held * SHORT);
+            mask |= u128::from(bits) << (held * SHORT);
             starts[held] = s;
             held += 1;
             s += SHORT;
@@ -247,7 +249,7 @@ fn test_ranges(
 /// bit order, and clears the mask.
 #[inline(always)]
 fn take_hits(
-    mask: &mut u64,
+    mask: &mut u128,
     starts: &[usize; GROUP],
     (x, y, z): (&[f32], &[f32], &[f32]),
     me: [f32; 3],
