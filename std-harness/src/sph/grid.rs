@@ -450,32 +450,49 @@ mod tests {
 
     #[test]
     fn counting_sort_is_stable_and_complete() {
-        let points: Vec<Vec3> = (0..500)
-            .map(|i| {
-                let t = i as f32;
-                Vec3::new((t * 0.37).sin(), (t * 0.11).cos(), (t * 0.07).sin()) * 0.05
-            })
-            .collect();
-        let mut grid = Grid::new(points.len(), 0.01);
-        let bucket: Vec<u32> = points
-            .iter()
-            .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.row_mask()))
-            .collect();
-        grid.sort(&bucket);
-        let order = grid.order.clone();
-        let mut seen = vec![false; points.len()];
-        for b in 0..grid.buckets() {
-            let range = grid.bucket_start[b] as usize..grid.bucket_start[b + 1] as usize;
-            let members = &order[range.clone()];
-            // Stable: ascending particle index within each bucket.
-            assert!(members.windows(2).all(|w| w[0] < w[1]));
-            for (k, &p) in range.zip(members) {
-                assert_eq!(bucket[p as usize], b as u32);
-                assert_eq!(grid.rank[p as usize], k as u32);
-                seen[p as usize] = true;
+        // One sort chunk, and several (30,001 particles: four chunks, the last part-filled,
+        // each with particles in many of the 64 parts), on one and on two threads.
+        for count in [500, 30_001] {
+            let points: Vec<Vec3> = (0..count)
+                .map(|i| {
+                    let t = i as f32;
+                    Vec3::new((t * 0.37).sin(), (t * 0.11).cos(), (t * 0.07).sin()) * 0.05
+                })
+                .collect();
+            let mut orders = Vec::new();
+            for threads in [1, 2] {
+                let mut grid = Grid::new(points.len(), 0.01);
+                let bucket: Vec<u32> = points
+                    .iter()
+                    .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.row_mask()))
+                    .collect();
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                pool.install(|| grid.sort(&bucket));
+                let order = grid.order.clone();
+                let mut seen = vec![false; points.len()];
+                for b in 0..grid.buckets() {
+                    let range = grid.bucket_start[b] as usize..grid.bucket_start[b + 1] as usize;
+                    let members = &order[range.clone()];
+                    // Stable: ascending particle index within each bucket.
+                    assert!(members.windows(2).all(|w| w[0] < w[1]));
+                    for (k, &p) in range.zip(members) {
+                        assert_eq!(bucket[p as usize], b as u32);
+                        assert_eq!(grid.rank[p as usize], k as u32);
+                        seen[p as usize] = true;
+                    }
+                }
+                assert!(
+                    seen.iter().all(|&s| s),
+                    "{count} particles, {threads} threads"
+                );
+                assert_eq!(grid.bucket_start[grid.buckets()] as usize, count);
+                orders.push(order);
             }
+            assert_eq!(orders[0], orders[1], "{count} particles: 1 vs 2 threads");
         }
-        assert!(seen.iter().all(|&s| s));
     }
 
     #[test]
