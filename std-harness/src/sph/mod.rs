@@ -30,6 +30,9 @@ use rayon::prelude::*;
 /// count, so that the split — and with it every result — is the same on any number of threads.
 pub const CHUNK: usize = 1024;
 
+/// The largest neighbour cap a scene may set.
+pub const MAX_CAP: usize = 256;
+
 /// SPH parameters (scene section `[hair_hair]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SphParams {
@@ -82,7 +85,7 @@ impl SphParams {
             "viscosity: allowed 0 to 200",
         )?;
         check(
-            (1..=256).contains(&self.neighbour_cap),
+            (1..=MAX_CAP).contains(&self.neighbour_cap),
             "neighbour_cap: allowed 1 to 256",
         )?;
         check(

@@ -8,11 +8,14 @@
 //! sorted structure-of-arrays positions, looked up once per cell (the sorted particles of a
 //! cell are consecutive). Each range is tested where it lies, four candidates at a time for
 //! `r² < h²` (no square root; one packed compare on x86-64), in pieces of eight with no branch
-//! on the range's length, and the hits of many pieces are taken from one mask
-//! ([`test_ranges`]): what costs here is mispredicted branches more than instructions (session
-//! 4 copied the candidates into one run to avoid them; valgrind's branch simulation counts 7.5 M
-//! mispredictions per 7 steps of Mannequin A now, 11.6 M then, and 1,190 instructions per
-//! particle against 1,930). The first `cap` hits (that are not the
+//! on the range's length, and the hits of many pieces are taken from one mask, a byte a piece
+//! ([`test_ranges`]). Two consecutive particles of one cell share that pass: each piece is
+//! loaded once and tested for both. What costs here is mispredicted branches and cache misses
+//! more than instructions: valgrind's branch simulation (the whole pass, 7 SPH steps of
+//! Mannequin A, `--toggle-collect='*NeighbourLists*build*'`) counts 11.7 M mispredictions and
+//! 4.50 G instructions in session 5's pass, 8.5 M and 3.87 G now (the kept density term
+//! without a branch took 2.4 M of them; a variable shift of a 128-bit mask, 0.6 G
+//! instructions, but no measurable time). The first `cap` hits (that are not the
 //! particle itself nor its own strand's near nodes) are kept, in scan order. The order is a
 //! function of the positions only, so lists, truncation and every sum over a list are the
 //! same on any number of threads.
@@ -25,7 +28,7 @@ use rayon::prelude::*;
 
 use super::forces::{poly6_factor, SortedParticles};
 use super::grid::{cell_of, Grid, RowsAround, MAX_RANGES};
-use super::{SphParams, CHUNK};
+use super::{SphParams, CHUNK, MAX_CAP};
 
 /// Entries past the last particle in the position arrays: a range is tested in pieces of
 /// [`SHORT`] candidates whatever its length (at least that many).
@@ -129,32 +132,36 @@ impl NeighbourLists {
                 // consecutive and share them.
                 let mut ranged: Option<([i32; 3], usize)> = None;
                 let mut used = 0usize;
-                for k in 0..count.len() {
+                // The second particle of a pair gathers its list here; it is moved next to
+                // the first one's once that one's length is known.
+                let mut spare = [0u32; MAX_CAP + 1];
+                let record_len = count.len();
+                let mut record = |k: usize, a: usize, me: [f32; 3], list: &Gathered| {
+                    start[k] = (c * (CHUNK * cap + 1) + list.at) as u32;
+                    count[k] = list.kept as u32;
+                    found.kept += list.kept as u64;
+                    found.truncated += u64::from(list.all) - list.kept as u64;
+                    found.max_found = found.max_found.max(list.all);
+                    let rho = c6 * list.sum;
+                    let pr = (stiffness * (rho - rest)).max(0.0);
+                    density[k] = rho;
+                    let [vx, vy, vz] = velocity[a];
+                    packed[k] = [me[0], me[1], me[2], mass[a] / rho, vx, vy, vz, pr];
+                };
+                let near = Near {
+                    key,
+                    mass,
+                    cap,
+                    gap,
+                    h2,
+                };
+                let mut k = 0;
+                // Bounded: `k` moves on by one or two a pass.
+                while k < record_len {
                     let a = c * CHUNK + k;
                     let me = [x[a], y[a], z[a]];
                     let cell = cell_of(me.into(), inverse_cell);
                     rows.update(cell, row_mask);
-                    let my_key = key[a];
-                    // One entry of room past the cap: a hit is written whether it is kept or
-                    // not, and counted only if it is (no branch on it).
-                    let mine = &mut list[used..used + cap + 1];
-                    let mut kept = 0usize;
-                    let mut all = 0u32;
-                    // ρ / (315/(64π h⁹)): own mass, then the kept neighbours in list order.
-                    let mut sum = mass[a] * h2 * h2 * h2;
-                    let mut hit = |j: usize, d2: f32| {
-                        let (Some(&other), Some(&m)) = (key.get(j), mass.get(j)) else {
-                            return;
-                        };
-                        let neighbour = (j != a) & !near_on_strand(other, my_key, gap);
-                        let keep = neighbour & (kept < cap);
-                        mine[kept.min(cap)] = j as u32;
-                        let w = h2 - d2;
-                        // Adding +0 leaves the sum's bits as they are.
-                        sum += if keep { m * (w * w * w) } else { 0.0 };
-                        kept += usize::from(keep);
-                        all += u32::from(neighbour);
-                    };
                     let m = match ranged {
                         Some((of, m)) if of == cell => m,
                         _ => {
@@ -163,22 +170,135 @@ impl NeighbourLists {
                             m
                         }
                     };
-                    test_ranges(&ranges[..m], (x, y, z), me, h2, &mut hit);
-                    start[k] = (c * (CHUNK * cap + 1) + used) as u32;
-                    count[k] = kept as u32;
-                    used += kept;
-                    found.kept += kept as u64;
-                    found.truncated += u64::from(all) - kept as u64;
-                    found.max_found = found.max_found.max(all);
-                    let rho = c6 * sum;
-                    let pr = (stiffness * (rho - rest)).max(0.0);
-                    density[k] = rho;
-                    let [vx, vy, vz] = velocity[a];
-                    packed[k] = [me[0], me[1], me[2], mass[a] / rho, vx, vy, vz, pr];
+                    // The next particle, if it is in the same cell: the two share one pass
+                    // over their ranges (the loads, the range and piece bookkeeping).
+                    let b = a + 1;
+                    let pair = (k + 1 < record_len)
+                        .then(|| [x[b], y[b], z[b]])
+                        .filter(|&other| cell_of(other.into(), inverse_cell) == cell);
+                    let mut one = Gather::new(a, key[a], mass[a] * h2 * h2 * h2, used);
+                    let mine = &mut list[used..used + cap + 1];
+                    let two = match pair {
+                        Some(other) => {
+                            let mut two = Gather::new(b, key[b], mass[b] * h2 * h2 * h2, 0);
+                            let theirs = &mut spare[..cap + 1];
+                            test_ranges(
+                                &ranges[..m],
+                                (x, y, z),
+                                [me, other],
+                                h2,
+                                &mut |p, j, d2| {
+                                    if p == 0 {
+                                        one.hit(j, d2, &near, mine);
+                                    } else {
+                                        two.hit(j, d2, &near, theirs);
+                                    }
+                                },
+                            );
+                            Some(two.done())
+                        }
+                        None => {
+                            test_ranges(&ranges[..m], (x, y, z), [me], h2, &mut |_, j, d2| {
+                                one.hit(j, d2, &near, mine);
+                            });
+                            None
+                        }
+                    };
+                    let one = one.done();
+                    record(k, a, me, &one);
+                    used += one.kept;
+                    if let (Some(mut two), Some(other)) = (two, pair) {
+                        list[used..used + two.kept].copy_from_slice(&spare[..two.kept]);
+                        two.at = used;
+                        record(k + 1, b, other, &two);
+                        used += two.kept;
+                    }
+                    k += 1 + usize::from(pair.is_some());
                 }
                 found
             })
             .reduce(Found::default, Found::merge)
+    }
+}
+
+/// What a particle's hits are checked against: the sorted keys and masses, the cap, the
+/// same-strand gap and `h²`.
+struct Near<'a> {
+    key: &'a [u32],
+    mass: &'a [f32],
+    cap: usize,
+    gap: u32,
+    h2: f32,
+}
+
+/// One particle's list being gathered.
+struct Gather {
+    /// The particle (sorted index).
+    a: usize,
+    /// Its key.
+    key: u32,
+    /// Where its list starts in the chunk's storage.
+    at: usize,
+    kept: usize,
+    all: u32,
+    /// `ρ / (315/(64π h⁹))`: own mass, then the kept neighbours in list order.
+    sum: f32,
+}
+
+/// A gathered list: where it starts, how many were kept and found, and the density sum.
+struct Gathered {
+    at: usize,
+    kept: usize,
+    all: u32,
+    sum: f32,
+}
+
+impl Gather {
+    #[inline(always)]
+    fn new(a: usize, key: u32, own: f32, at: usize) -> Gather {
+        Gather {
+            a,
+            key,
+            at,
+            kept: 0,
+            all: 0,
+            sum: own,
+        }
+    }
+
+    /// Takes sorted particle `j` at `r² = d2` (within `h`): a neighbour unless it is the
+    /// particle itself or a near node of its own strand, kept while there is room under the
+    /// cap. It is written to `list` whether it is kept or not, and counted only if it is (no
+    /// branch on it: `list` has one entry of room past the cap).
+    #[inline(always)]
+    fn hit(&mut self, j: usize, d2: f32, near: &Near<'_>, list: &mut [u32]) {
+        let (Some(&other), Some(&m)) = (near.key.get(j), near.mass.get(j)) else {
+            return;
+        };
+        let neighbour = (j != self.a) & !near_on_strand(other, self.key, near.gap);
+        let keep = neighbour & (self.kept < near.cap);
+        if let Some(slot) = list.get_mut(self.kept.min(near.cap)) {
+            *slot = j as u32;
+        }
+        let w = near.h2 - d2;
+        // `m · 1` is `m` and `m · 0` is +0 (masses are positive), and adding +0 leaves the
+        // sum's bits as they are: the kept term without a branch, which LLVM makes of an
+        // `if` here and which mispredicts (a particle's own and same-strand hits come at
+        // random places in its list).
+        let m = m * f32::from(u8::from(keep));
+        self.sum += m * (w * w * w);
+        self.kept += usize::from(keep);
+        self.all += u32::from(neighbour);
+    }
+
+    #[inline(always)]
+    fn done(self) -> Gathered {
+        Gathered {
+            at: self.at,
+            kept: self.kept,
+            all: self.all,
+            sum: self.sum,
+        }
     }
 }
 
@@ -197,69 +317,121 @@ const GROUP: usize = 16;
 /// A range is tested in pieces of this many particles: two blocks, whatever its length.
 const SHORT: usize = 2 * LANES;
 
-const _: () = assert!(PADDING >= SHORT && GROUP * SHORT <= 128);
+const _: () = assert!(PADDING >= SHORT && SHORT == 8 && GROUP * SHORT == 128);
 
-/// Calls `hit(j, r²)` for every sorted particle `j` of `ranges` with `r² < h2`, in order
-/// (range by range, each in sorted order), testing them where they lie. A range is tested in
-/// pieces of [`SHORT`] (most ranges are one piece: a range holds about five particles on a
-/// head), each as two blocks of [`LANES`] with the lanes past the range's end masked off — the
-/// position arrays have [`PADDING`] entries past the last particle — and the hits of up to
-/// [`GROUP`] pieces go into one mask, so that neither a range's length nor its hits cost a
-/// branch of their own; the few hits are then taken from the mask in one loop.
+/// A piece's hits past the end of its range are masked off with `TAIL[(e − s).min(SHORT)]`:
+/// a table, not a variable shift.
+const TAIL: [u8; SHORT + 1] = {
+    let mut tail = [0u8; SHORT + 1];
+    let mut k = 0;
+    while k < SHORT {
+        tail[k + 1] = tail[k] << 1 | 1;
+        k += 1;
+    }
+    tail
+};
+
+/// Calls `hit(p, j, r²)` for every sorted particle `j` of `ranges` with `r² < h2` from
+/// particle `p`'s position `me[p]`, in order for each `p` (range by range, each in sorted
+/// order), testing them where they lie. `P` particles of one cell share the pass: each piece
+/// is loaded once and tested for each of them. A range is tested in pieces of [`SHORT`] (most
+/// ranges are one piece: a range holds about five particles on a head), each as two blocks of
+/// [`LANES`] with the lanes past the range's end masked off — the position arrays have
+/// [`PADDING`] entries past the last particle — and the hits of up to [`GROUP`] pieces go into
+/// one mask, a byte a piece, so that neither a range's length nor its hits cost a branch of
+/// their own; the few hits are then taken from the mask in one loop.
 #[inline(always)]
-fn test_ranges(
+fn test_ranges<const P: usize>(
     ranges: &[(u32, u32)],
     xyz: (&[f32], &[f32], &[f32]),
-    me: [f32; 3],
+    me: [[f32; 3]; P],
     h2: f32,
-    hit: &mut impl FnMut(usize, f32),
+    hit: &mut impl FnMut(usize, usize, f32),
 ) {
-    let (x, y, z) = xyz;
-    let mut mask = 0u128;
-    let mut starts = [0usize; GROUP];
+    let mut hits = [[0u8; GROUP]; P];
+    let mut starts = [0u32; GROUP];
     let mut held = 0;
     for &(s, e) in ranges {
-        let (mut s, e) = (s as usize, e.max(s) as usize);
+        let e = e.max(s);
+        let mut s = s;
         // Bounded: `s` moves on by SHORT a pass until it reaches `e`.
         loop {
             if held == GROUP {
-                take_hits(&mut mask, &starts, xyz, me, hit);
+                for (p, (hits, me)) in hits.iter_mut().zip(me).enumerate() {
+                    take_hits(
+                        u128::from_le_bytes(*hits),
+                        &starts,
+                        xyz,
+                        me,
+                        &mut |j, d2| hit(p, j, d2),
+                    );
+                    *hits = [0; GROUP];
+                }
                 held = 0;
             }
-            let mut bits = 0;
-            for block in 0..SHORT / LANES {
-                let at = s + block * LANES;
-                if let (Some(bx), Some(by), Some(bz)) = (lanes(x, at), lanes(y, at), lanes(z, at)) {
-                    bits |= within(bx, by, bz, me, h2) << (block * LANES);
-                }
+            let tail = TAIL[((e - s) as usize).min(SHORT)];
+            let bits = piece(xyz, s as usize, me, h2);
+            for (hits, bits) in hits.iter_mut().zip(bits) {
+                hits[held % GROUP] = bits & tail;
             }
-            bits &= (1 << (e - s).min(SHORT)) - 1;
-            mask |= u128::from(bits) << (held * SHORT);
-            starts[held] = s;
+            starts[held % GROUP] = s;
             held += 1;
-            s += SHORT;
+            s += SHORT as u32;
             if s >= e {
                 break;
             }
         }
     }
-    take_hits(&mut mask, &starts, xyz, me, hit);
+    for (p, (hits, me)) in hits.iter().zip(me).enumerate() {
+        take_hits(
+            u128::from_le_bytes(*hits),
+            &starts,
+            xyz,
+            me,
+            &mut |j, d2| hit(p, j, d2),
+        );
+    }
+}
+
+/// A bit per candidate `s .. s + SHORT` with `r² < h2` from each of `me` (all of them read:
+/// the arrays are padded), as two blocks of [`LANES`].
+#[inline(always)]
+fn piece<const P: usize>(
+    (x, y, z): (&[f32], &[f32], &[f32]),
+    s: usize,
+    me: [[f32; 3]; P],
+    h2: f32,
+) -> [u8; P] {
+    let (Some(bx), Some(by), Some(bz)) = (block(x, s), block(y, s), block(z, s)) else {
+        return [0; P];
+    };
+    let ((Some(x0), Some(x1)), (Some(y0), Some(y1)), (Some(z0), Some(z1))) =
+        (halves(bx), halves(by), halves(bz))
+    else {
+        return [0; P];
+    };
+    let (low, high) = ((x0, y0, z0), (x1, y1, z1));
+    me.map(|me| {
+        let low = within(low.0, low.1, low.2, me, h2);
+        let high = within(high.0, high.1, high.2, me, h2);
+        (low | high << LANES) as u8
+    })
 }
 
 /// Calls `hit` for each set bit of `mask` (bit `SHORT · g + l`: particle `starts[g] + l`), in
-/// bit order, and clears the mask.
+/// bit order.
 #[inline(always)]
 fn take_hits(
-    mask: &mut u128,
-    starts: &[usize; GROUP],
+    mut mask: u128,
+    starts: &[u32; GROUP],
     (x, y, z): (&[f32], &[f32], &[f32]),
     me: [f32; 3],
     hit: &mut impl FnMut(usize, f32),
 ) {
-    while *mask != 0 {
+    while mask != 0 {
         let bit = mask.trailing_zeros() as usize;
-        *mask &= *mask - 1;
-        let j = starts[bit / SHORT] + bit % SHORT;
+        mask &= mask - 1;
+        let j = starts[bit / SHORT] as usize + bit % SHORT;
         let (Some(&xj), Some(&yj), Some(&zj)) = (x.get(j), y.get(j), z.get(j)) else {
             continue;
         };
@@ -267,10 +439,16 @@ fn take_hits(
     }
 }
 
-/// The `LANES` entries of `v` from `at`.
+/// The two blocks of a piece.
 #[inline(always)]
-fn lanes(v: &[f32], at: usize) -> Option<&[f32; LANES]> {
-    v.get(at..at + LANES)?.try_into().ok()
+fn halves(v: &[f32; SHORT]) -> (Option<&[f32; LANES]>, Option<&[f32; LANES]>) {
+    (v.first_chunk::<LANES>(), v.last_chunk::<LANES>())
+}
+
+/// The `SHORT` entries of `v` from `at`.
+#[inline(always)]
+fn block(v: &[f32], at: usize) -> Option<&[f32; SHORT]> {
+    v.get(at..at + SHORT)?.try_into().ok()
 }
 
 /// `|a − b|²`, summed as `(dx² + dy²) + dz²` — the order of [`within`] and of the brute-force
