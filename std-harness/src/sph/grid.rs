@@ -2,19 +2,27 @@
 //! lines 2–4). Cells are cubes of the smoothing length `h`, so every neighbour of a particle
 //! lies in its own cell or one of the 26 around it.
 //!
-//! Cells map to a power-of-two number of buckets laid out in *rows*: a row is 16 cells side by
-//! side along x, rows are grouped in bricks of 4 × 4 ([`row_of`]) placed by a hash, and within
-//! a row 16 consecutive buckets take `x mod 16`. Three cells side by side along x are then (but
-//! where they cross from one row to the next) three consecutive buckets, which after the sort
-//! are one contiguous run of particles: the 27 cells around a particle are read as at most 18
-//! contiguous ranges of the sorted arrays, 9 in most places. Distinct cells may share a bucket
-//! (rows collide); the neighbour search filters by distance.
+//! Cells map to a power-of-two number of buckets laid out as a periodic raster ([`Layout`]):
+//! a *row* is 64 cells side by side along x, rows follow each other along y, then slabs along
+//! z, each axis wrapping around (the hash is a modulo). Three cells side by side along x are
+//! then (but where the row wraps around) three consecutive buckets, which after the sort are
+//! one contiguous run of particles: the 27 cells around a particle are read as at most 18
+//! contiguous ranges of the sorted arrays, 9 in most places. Distinct cells a period apart
+//! share a bucket; the neighbour search filters by distance.
+//!
+//! Why a raster and not a hash of the cell, as the paper's (and Teschner et al. 2003's)
+//! spatial hash: the nine rows around a particle are then its own, the ones beside it along y,
+//! and those one slab away along z, so a pass over the sorted particles reads a band about
+//! three slabs deep, which stays in the core's own cache. Session 5's rows were placed by a
+//! hash in bricks of 4 × 4: most particles read rows from several bricks at random places,
+//! and the neighbour pass waited on memory (Mannequin A's neighbour search 42–44 → 32 ms on
+//! one thread, the stage bench, old and new binary alternately).
 
 use hairsim_core::Vec3;
 use rayon::prelude::*;
 
 /// Buckets in a row (consecutive cells along x).
-pub const ROW: u32 = 16;
+pub const ROW: u32 = 64;
 
 /// Integer cell coordinates of `p` for cells of size `1 / inverse_cell`. Coordinates are
 /// clamped so that far-away (or non-finite) positions cannot overflow.
@@ -39,34 +47,61 @@ pub fn floor_clamped(t: f32) -> i32 {
     i - i32::from((i as f32) > t)
 }
 
-/// The row holding cell `(x, y, z)`. Rows come in *bricks* of 4 × 4 rows (16 × 4 × 4 cells),
-/// placed by the spatial hash of Teschner et al. 2003 on `(x div 16, y div 4, z div 4)`; within
-/// a brick, `(y mod 4, z mod 4)` picks the row. The 9 rows around a cell then mostly lie in one
-/// or two bricks: a few kilobytes of the sorted arrays rather than nine random places.
-#[inline]
-#[must_use]
-pub fn row_of(x: i32, y: i32, z: i32, row_mask: u32) -> u32 {
-    let brick = brick_x(x >> 4) ^ brick_yz(y, z);
-    ((brick << 4) | ((y as u32 & 3) << 2) | (z as u32 & 3)) & row_mask
+/// How cells map to buckets: a periodic raster. Cell `(x, y, z)` is bucket
+/// `row · ROW + (x mod ROW)` with `row = (z mod NZ) · NY + (y mod NY)` ([`Layout::row`]):
+/// rows of [`ROW`] cells along x, rows along y, then slabs along z, wrapping around in each
+/// axis. Cells a period apart share a bucket (the neighbour search filters by distance), and
+/// cells side by side are side by side in the buckets: the rows around a row are one and one
+/// slab away, so a pass over the sorted particles reads about three slabs at a time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    /// `NY − 1`.
+    y_mask: u32,
+    /// `log₂ NY`.
+    z_shift: u32,
+    /// `NZ − 1`.
+    z_mask: u32,
 }
 
-/// The x part of a brick's hash, for the brick `x div 16`.
-#[inline(always)]
-fn brick_x(brick: i32) -> u32 {
-    (brick as u32).wrapping_mul(73_856_093)
-}
+impl Layout {
+    /// A layout with `2^y_bits` rows along y and `2^z_bits` slabs along z.
+    #[must_use]
+    pub fn new(y_bits: u32, z_bits: u32) -> Layout {
+        Layout {
+            y_mask: (1 << y_bits) - 1,
+            z_shift: y_bits,
+            z_mask: (1 << z_bits) - 1,
+        }
+    }
 
-/// The y and z parts of the hash of the brick holding rows `y`, `z`.
-#[inline(always)]
-fn brick_yz(y: i32, z: i32) -> u32 {
-    ((y >> 2) as u32).wrapping_mul(19_349_663) ^ ((z >> 2) as u32).wrapping_mul(83_492_791)
+    /// `2^row_bits` rows shared between y and z as the box of `cells` (its size along y and
+    /// z, in cells) asks: at least four each way (so that the nine rows around a row are
+    /// distinct), then each further doubling to the axis whose cells wrap around most.
+    #[must_use]
+    pub fn fitting(row_bits: u32, cells: [f32; 2]) -> Layout {
+        let mut bits = [2u32, 2];
+        for _ in 4..row_bits.max(4) {
+            // Ties to y; an axis whose size is not a number takes no doubling it need not.
+            let wraps = |axis: usize| cells[axis] / (1u64 << bits[axis]) as f32;
+            let axis = usize::from(wraps(1) > wraps(0));
+            bits[axis] += 1;
+        }
+        Layout::new(bits[0], bits[1])
+    }
+
+    /// The row holding the cells `(·, y, z)`.
+    #[inline(always)]
+    #[must_use]
+    pub fn row(self, y: i32, z: i32) -> u32 {
+        ((z as u32 & self.z_mask) << self.z_shift) | (y as u32 & self.y_mask)
+    }
 }
 
 /// The bucket of a cell.
 #[inline]
 #[must_use]
-pub fn bucket_of(cell: [i32; 3], row_mask: u32) -> u32 {
-    row_of(cell[0], cell[1], cell[2], row_mask) * ROW + (cell[0] as u32 & (ROW - 1))
+pub fn bucket_of(cell: [i32; 3], layout: Layout) -> u32 {
+    layout.row(cell[1], cell[2]) * ROW + (cell[0] as u32 & (ROW - 1))
 }
 
 /// Parts of the bucket range the counting sort's second pass sorts side by side.
@@ -80,7 +115,7 @@ const SORT_CHUNK: usize = 8192;
 #[derive(Clone, Debug)]
 pub struct Grid {
     inverse_cell: f32,
-    row_mask: u32,
+    layout: Layout,
     /// `bucket >> part_shift` is the bucket's part.
     part_shift: u32,
     /// `bucket_start[b] .. bucket_start[b + 1]` are bucket `b`'s particles in sorted order
@@ -104,15 +139,18 @@ pub struct Grid {
 
 impl Grid {
     /// A grid for `particles` particles and cells of size `h`: about one bucket per particle
-    /// (a power of two, whole rows), so that unrelated cells are mostly apart.
+    /// (a power of two, whole rows), so that unrelated cells are mostly apart. `extent` is
+    /// the size of the box the particles start in, m: the rows along y and the slabs along z
+    /// are shared out as it is ([`Layout::fitting`]), so that the hair's cells wrap around as
+    /// little as the buckets allow.
     #[must_use]
-    pub fn new(particles: usize, h: f32) -> Grid {
+    pub fn new(particles: usize, h: f32, extent: [f32; 3]) -> Grid {
         let rows = (particles.next_power_of_two() / ROW as usize).max(16);
         let buckets = rows * ROW as usize;
         let chunks = particles.div_ceil(SORT_CHUNK);
         Grid {
             inverse_cell: 1.0 / h,
-            row_mask: (rows - 1) as u32,
+            layout: Layout::fitting(rows.trailing_zeros(), [extent[1] / h, extent[2] / h]),
             part_shift: (buckets / PARTS).trailing_zeros(),
             bucket_start: vec![0; buckets + 2],
             rank: vec![0; particles],
@@ -131,10 +169,10 @@ impl Grid {
         self.inverse_cell
     }
 
-    /// The row mask (rows − 1).
+    /// How cells map to buckets.
     #[must_use]
-    pub fn row_mask(&self) -> u32 {
-        self.row_mask
+    pub fn layout(&self) -> Layout {
+        self.layout
     }
 
     /// Sorts particles `0 .. bucket.len()` by their buckets: `order` (sorted position to
@@ -347,21 +385,17 @@ fn sort_parts(
 }
 
 /// The nine rows around a cell's row — `(y + dy, z + dz)` for `dy, dz` in −1 ..= 1, own row
-/// first, then the others in `(dy, dz)` order — as bucket offsets (row · [`ROW`]), for the
-/// brick of `x div 16` and the bricks on either side (read only where `x mod 16` is 0 or 15).
+/// first, then the others in `(dy, dz)` order — as bucket offsets (row · [`ROW`]).
 ///
-/// The nine rows are always distinct, so no bucket is ever read twice: their low four bits are
-/// `((y + dy) mod 4, (z + dz) mod 4)`, and three consecutive integers are distinct mod 4.
+/// The nine rows are always distinct, so no bucket is ever read twice: a layout has at least
+/// four rows along y and four slabs along z, and three consecutive integers are distinct mod 4.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RowsAround {
-    /// The cell's `(x div 16, y, z)` these rows are for.
-    key: [i32; 3],
-    /// Bucket offset of each row in the cell's brick along x.
+    /// The cell's `(y, z)` these rows are for.
+    key: [i32; 2],
+    /// Bucket offset of each row.
     own: [u32; 9],
-    /// Each row's hash parts but x's: y and z's part of the brick's hash, and the row's
-    /// `(y mod 4, z mod 4)` (for the bricks on either side, seldom read).
-    yz: [(u32, u32); 9],
-    row_mask: u32,
+    layout: Layout,
 }
 
 /// `(dy, dz)` of the nine rows, own row first.
@@ -377,48 +411,41 @@ const AROUND: [(i32, i32); 9] = [
     (1, 1),
 ];
 
-/// At most this many ranges around a cell: nine rows, and one cell across a brick's edge in
-/// each.
+/// At most this many ranges around a cell: nine rows, and in each the cell across the row's
+/// wrap-around.
 pub const MAX_RANGES: usize = 18;
 
 impl RowsAround {
     /// Rows that match no cell (`key` out of the clamped range).
     pub const NONE: RowsAround = RowsAround {
-        key: [i32::MIN; 3],
+        key: [i32::MIN; 2],
         own: [0; 9],
-        yz: [(0, 0); 9],
-        row_mask: 0,
+        layout: Layout {
+            y_mask: 0,
+            z_shift: 0,
+            z_mask: 0,
+        },
     };
 
     /// The rows around `cell`: kept as they are when `cell` is in the same row as the cell
     /// they were computed for (consecutive sorted particles mostly are).
     #[inline]
-    pub fn update(&mut self, cell: [i32; 3], row_mask: u32) {
-        let [x, y, z] = cell;
-        let key = [x >> 4, y, z];
-        if key == self.key && row_mask == self.row_mask {
+    pub fn update(&mut self, cell: [i32; 3], layout: Layout) {
+        let [_, y, z] = cell;
+        let key = [y, z];
+        if key == self.key && layout == self.layout {
             return;
         }
         self.key = key;
-        self.row_mask = row_mask;
-        let bx = brick_x(key[0]);
-        for (i, (dy, dz)) in AROUND.into_iter().enumerate() {
-            let (y, z) = (y.wrapping_add(dy), z.wrapping_add(dz));
-            self.yz[i] = (brick_yz(y, z), ((y as u32 & 3) << 2) | (z as u32 & 3));
-            self.own[i] = self.row(i, bx);
+        self.layout = layout;
+        for (own, (dy, dz)) in self.own.iter_mut().zip(AROUND) {
+            *own = layout.row(y.wrapping_add(dy), z.wrapping_add(dz)) * ROW;
         }
     }
 
-    /// Bucket offset of row `i` in the brick whose x hash part is `bx`.
-    #[inline(always)]
-    fn row(&self, i: usize, bx: u32) -> u32 {
-        let (yz, low) = self.yz[i];
-        ((((bx ^ yz) << 4) | low) & self.row_mask) * ROW
-    }
-
     /// The sorted ranges of the 27 cells around `cell` (whose rows these are), in the fixed
-    /// order: per row, cells `x − 1 ..= x + 1` within the row, then the one across the
-    /// brick's edge if any. Writes them to `out` and returns how many.
+    /// order: per row, cells `x − 1 ..= x + 1` within the row, then the one across the row's
+    /// wrap-around if any. Writes them to `out` and returns how many.
     #[inline(always)]
     pub fn ranges(&self, grid: &Grid, cell: [i32; 3], out: &mut [(u32, u32); MAX_RANGES]) -> usize {
         let low = cell[0] as u32 & (ROW - 1);
@@ -429,15 +456,11 @@ impl RowsAround {
             }
             return 9;
         }
-        // Across the edge: bucket 15 of the brick before, or bucket 0 of the one after.
-        let (side, bucket) = if low == 0 {
-            (brick_x(self.key[0].wrapping_sub(1)), ROW - 1)
-        } else {
-            (brick_x(self.key[0].wrapping_add(1)), 0)
-        };
+        // Across the wrap-around: the row's last cell, or its first.
+        let across = if low == 0 { ROW - 1 } else { 0 };
         for i in 0..9 {
             out[2 * i] = grid.range(self.own[i] + first, self.own[i] + last);
-            let b = self.row(i, side) + bucket;
+            let b = self.own[i] + across;
             out[2 * i + 1] = grid.range(b, b);
         }
         MAX_RANGES
@@ -461,10 +484,10 @@ mod tests {
                 .collect();
             let mut orders = Vec::new();
             for threads in [1, 2] {
-                let mut grid = Grid::new(points.len(), 0.01);
+                let mut grid = Grid::new(points.len(), 0.01, [0.1; 3]);
                 let bucket: Vec<u32> = points
                     .iter()
-                    .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.row_mask()))
+                    .map(|&p| bucket_of(cell_of(p, grid.inverse_cell()), grid.layout()))
                     .collect();
                 let pool = rayon::ThreadPoolBuilder::new()
                     .num_threads(threads)
@@ -497,7 +520,7 @@ mod tests {
 
     #[test]
     fn the_ranges_around_a_cell_hold_its_27_cells_each_particle_once() {
-        // Few rows (16), many cells: rows and buckets collide, and x wraps at 0 and 15.
+        // Few rows (16), many cells: rows and buckets collide, and x wraps at 0 and 63.
         for centre in [
             [0, 0, 0],
             [15, 3, -2],
@@ -523,17 +546,17 @@ mod tests {
                     (k % 7) as f32,
                 ));
             }
-            let mut grid = Grid::new(256, 1.0);
+            let mut grid = Grid::new(256, 1.0, [1.0; 3]);
             let bucket: Vec<u32> = points
                 .iter()
-                .map(|&p| bucket_of(cell_of(p, 1.0), grid.row_mask()))
+                .map(|&p| bucket_of(cell_of(p, 1.0), grid.layout()))
                 .collect();
             grid.sort(&bucket);
             let order = &grid.order;
             let mut rows = RowsAround::NONE;
             // Rows computed for another cell of the same row, then reused.
-            rows.update([centre[0] & !15, centre[1], centre[2]], grid.row_mask());
-            rows.update(centre, grid.row_mask());
+            rows.update([centre[0] + 1, centre[1], centre[2]], grid.layout());
+            rows.update(centre, grid.layout());
             let mut times = vec![0; points.len()];
             let mut ranges = [(0, 0); MAX_RANGES];
             let n = rows.ranges(&grid, centre, &mut ranges);
@@ -548,6 +571,18 @@ mod tests {
             );
             assert!(times.iter().all(|&t| t <= 1), "{centre:?}");
         }
+    }
+
+    #[test]
+    fn rows_are_shared_out_as_the_box_asks() {
+        // Mannequin A: a box about 100 cells high (y) and 78 deep (z), 2^13 rows.
+        assert_eq!(Layout::fitting(13, [100.0, 78.0]), Layout::new(7, 6));
+        // A flat box gets its rows along its long side, keeping four the other way.
+        assert_eq!(Layout::fitting(10, [1.0, 5000.0]), Layout::new(2, 8));
+        assert_eq!(Layout::fitting(10, [5000.0, 1.0]), Layout::new(8, 2));
+        // Too few rows to share: four each way, whatever the box.
+        assert_eq!(Layout::fitting(4, [0.0, 0.0]), Layout::new(2, 2));
+        assert_eq!(Layout::fitting(0, [f32::NAN, 3.0]), Layout::new(2, 2));
     }
 
     #[test]
@@ -571,6 +606,6 @@ mod tests {
             [1_000_000_000; 3]
         );
         assert_eq!(cell_of(Vec3::splat(-1.0e30), 100.0), [-1_000_000_000; 3]);
-        let _ = bucket_of(cell_of(Vec3::splat(f32::NAN), 100.0), 15);
+        let _ = bucket_of(cell_of(Vec3::splat(f32::NAN), 100.0), Layout::new(2, 2));
     }
 }

@@ -176,7 +176,7 @@ impl Sph {
         first.push(slot.len() as u32);
         Ok(Sph {
             params,
-            grid: grid::Grid::new(count, params.smoothing_length),
+            grid: grid::Grid::new(count, params.smoothing_length, extent(strands)),
             sorted: forces::SortedParticles::new(count),
             neighbours: neighbours::NeighbourLists::new(count, params.neighbour_cap),
             slot,
@@ -216,7 +216,7 @@ impl Sph {
     ) {
         let t0 = Instant::now();
         // Algorithm 1, line 2: read every node and hash it into a cell of size h.
-        let (inverse_cell, row_mask) = (self.grid.inverse_cell(), self.grid.row_mask());
+        let (inverse_cell, layout) = (self.grid.inverse_cell(), self.grid.layout());
         let (strand, node, mass) = (&self.strand, &self.node, &self.mass);
         (
             self.record.par_chunks_mut(CHUNK),
@@ -239,7 +239,7 @@ impl Sph {
                         mass: mass[p],
                         key: s << neighbours::NODE_BITS | i,
                     };
-                    *b = grid::bucket_of(grid::cell_of(x, inverse_cell), row_mask);
+                    *b = grid::bucket_of(grid::cell_of(x, inverse_cell), layout);
                 }
             });
         let t1 = Instant::now();
@@ -281,6 +281,18 @@ impl Sph {
         self.stats.time_neighbours += t3 - t2;
         self.stats.time_forces += t4 - t3;
     }
+}
+
+/// The size of the box holding every node of `strands`, m (zero for none).
+fn extent<const N: usize>(strands: &[Strand<N>]) -> [f32; 3] {
+    let mut low = Vec3::splat(f32::INFINITY);
+    let mut high = Vec3::splat(f32::NEG_INFINITY);
+    for strand in strands {
+        for &p in &strand.state.position[..strand.nodes()] {
+            (low, high) = (low.min(p), high.max(p));
+        }
+    }
+    (high - low).max(Vec3::ZERO).to_array()
 }
 
 #[cfg(test)]

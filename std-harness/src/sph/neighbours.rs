@@ -3,8 +3,8 @@
 //! the same pass, while the distances are at hand.
 //!
 //! Each particle's cell comes from its sorted position; the nine rows around it
-//! ([`RowsAround`]) are hashed once per run of particles in one row, and the 27 cells are read
-//! as nine ranges of three cells (more where the row crosses into the next brick) of the
+//! ([`RowsAround`]) are computed once per run of particles in one row, and the 27 cells are read
+//! as nine ranges of three cells (more where the row wraps around) of the
 //! sorted structure-of-arrays positions, looked up once per cell (the sorted particles of a
 //! cell are consecutive). Each range is tested where it lies, four candidates at a time for
 //! `r² < h²` (no square root; one packed compare on x86-64), in pieces of eight with no branch
@@ -103,7 +103,7 @@ impl NeighbourLists {
         let c6 = poly6_factor(h);
         let (stiffness, rest) = (params.stiffness, params.rest_density);
         let gap = params.same_strand_gap;
-        let (inverse_cell, row_mask) = (grid.inverse_cell(), grid.row_mask());
+        let (inverse_cell, layout) = (grid.inverse_cell(), grid.layout());
         let SortedParticles {
             x,
             y,
@@ -161,7 +161,7 @@ impl NeighbourLists {
                     let a = c * CHUNK + k;
                     let me = [x[a], y[a], z[a]];
                     let cell = cell_of(me.into(), inverse_cell);
-                    rows.update(cell, row_mask);
+                    rows.update(cell, layout);
                     let m = match ranged {
                         Some((of, m)) if of == cell => m,
                         _ => {
