@@ -51,8 +51,9 @@ pub fn floor_clamped(t: f32) -> i32 {
 /// `row · ROW + (x mod ROW)` with `row = (z mod NZ) · NY + (y mod NY)` ([`Layout::row`]):
 /// rows of [`ROW`] cells along x, rows along y, then slabs along z, wrapping around in each
 /// axis. Cells a period apart share a bucket (the neighbour search filters by distance), and
-/// cells side by side are side by side in the buckets: the rows around a row are one and one
-/// slab away, so a pass over the sorted particles reads about three slabs at a time.
+/// cells side by side are side by side in the buckets: the rows around a row are beside it
+/// along y or one slab away along z, so a pass over the sorted particles reads about three
+/// slabs at a time.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
     /// `NY − 1`.
@@ -81,7 +82,7 @@ impl Layout {
     pub fn fitting(row_bits: u32, cells: [f32; 2]) -> Layout {
         let mut bits = [2u32, 2];
         for _ in 4..row_bits.max(4) {
-            // Ties to y; an axis whose size is not a number takes no doubling it need not.
+            // Ties (and a size that is not a number) go to y.
             let wraps = |axis: usize| cells[axis] / (1u64 << bits[axis]) as f32;
             let axis = usize::from(wraps(1) > wraps(0));
             bits[axis] += 1;

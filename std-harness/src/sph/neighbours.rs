@@ -10,15 +10,16 @@
 //! `r² < h²` (no square root; one packed compare on x86-64), in pieces of eight with no branch
 //! on the range's length, and the hits of many pieces are taken from one mask, a byte a piece
 //! ([`test_ranges`]). Two consecutive particles of one cell share that pass: each piece is
-//! loaded once and tested for both. What costs here is mispredicted branches and cache misses
+//! loaded once and tested for both. What costs here is cache misses and mispredicted branches
 //! more than instructions: valgrind's branch simulation (the whole pass, 7 SPH steps of
 //! Mannequin A, `--toggle-collect='*NeighbourLists*build*'`) counts 11.7 M mispredictions and
 //! 4.50 G instructions in session 5's pass, 8.5 M and 3.87 G now (the kept density term
-//! without a branch took 2.4 M of them; a variable shift of a 128-bit mask, 0.6 G
-//! instructions, but no measurable time). The first `cap` hits (that are not the
-//! particle itself nor its own strand's near nodes) are kept, in scan order. The order is a
-//! function of the positions only, so lists, truncation and every sum over a list are the
-//! same on any number of threads.
+//! without a branch took 2.4 M of the mispredictions; the byte masks and the pairs took the
+//! instructions, and no time that could be measured), and the raster grid ([`super::grid`])
+//! took about 40 % off the pass's time by keeping the rows it reads in cache. The first `cap`
+//! hits (that are not the particle itself nor its own strand's near nodes) are kept, in scan
+//! order. The order is a function of the positions only, so lists, truncation and every sum
+//! over a list are the same on any number of threads.
 //!
 //! Lists are stored compactly: a chunk of particles writes its lists one after another into
 //! its own part of the storage, so the few neighbours a particle has (about five on a head)
