@@ -25,6 +25,7 @@
 //! its own part of the storage, so the few neighbours a particle has (about five on a head)
 //! take a few bytes, not a cache line and a half of room for `cap` of them.
 
+use hairsim_core::Vec3;
 use rayon::prelude::*;
 
 use super::forces::{poly6_factor, SortedParticles};
@@ -156,12 +157,15 @@ impl NeighbourLists {
                     gap,
                     h2,
                 };
+                let cell_at = |a: usize| cell_of(Vec3::new(x[a], y[a], z[a]), inverse_cell);
+                // Particle `k`'s cell when the previous pass looked it up already.
+                let mut known = None;
                 let mut k = 0;
                 // Bounded: `k` moves on by one or two a pass.
                 while k < record_len {
                     let a = c * CHUNK + k;
                     let me = [x[a], y[a], z[a]];
-                    let cell = cell_of(me.into(), inverse_cell);
+                    let cell = known.unwrap_or_else(|| cell_at(a));
                     rows.update(cell, layout);
                     let m = match ranged {
                         Some((of, m)) if of == cell => m,
@@ -174,9 +178,9 @@ impl NeighbourLists {
                     // The next particle, if it is in the same cell: the two share one pass
                     // over their ranges (the loads, the range and piece bookkeeping).
                     let b = a + 1;
-                    let pair = (k + 1 < record_len)
-                        .then(|| [x[b], y[b], z[b]])
-                        .filter(|&other| cell_of(other.into(), inverse_cell) == cell);
+                    let next = (k + 1 < record_len).then(|| cell_at(b));
+                    let pair = (next == Some(cell)).then(|| [x[b], y[b], z[b]]);
+                    known = if pair.is_some() { None } else { next };
                     let mut one = Gather::new(a, key[a], mass[a] * h2 * h2 * h2, used);
                     let mine = &mut list[used..used + cap + 1];
                     let two = match pair {
