@@ -190,7 +190,7 @@ impl NeighbourLists {
                             test_ranges(
                                 &ranges[..m],
                                 (x, y, z),
-                                [me, other],
+                                ([a, b], [me, other]),
                                 h2,
                                 &mut |p, j, d2| {
                                     if p == 0 {
@@ -203,9 +203,15 @@ impl NeighbourLists {
                             Some(two.done())
                         }
                         None => {
-                            test_ranges(&ranges[..m], (x, y, z), [me], h2, &mut |_, j, d2| {
-                                one.hit(j, d2, &near, mine);
-                            });
+                            test_ranges(
+                                &ranges[..m],
+                                (x, y, z),
+                                ([a], [me]),
+                                h2,
+                                &mut |_, j, d2| {
+                                    one.hit(j, d2, &near, mine);
+                                },
+                            );
                             None
                         }
                     };
@@ -349,14 +355,14 @@ const TAIL: [u8; SHORT + 1] = {
 fn test_ranges<const P: usize>(
     ranges: &[(u32, u32)],
     xyz: (&[f32], &[f32], &[f32]),
-    me: [[f32; 3]; P],
+    (own, me): ([usize; P], [[f32; 3]; P]),
     h2: f32,
     hit: &mut impl FnMut(usize, usize, f32),
 ) {
     let mut hits = [[0u8; GROUP]; P];
     let mut starts = [0u32; GROUP];
     let mut held = 0;
-    for &(s, e) in ranges {
+    for (r, &(s, e)) in ranges.iter().enumerate() {
         let e = e.max(s);
         let mut s = s;
         // Bounded: `s` moves on by SHORT a pass until it reaches `e`.
@@ -376,8 +382,11 @@ fn test_ranges<const P: usize>(
             }
             let tail = TAIL[((e - s) as usize).min(SHORT)];
             let bits = piece(xyz, s as usize, me, h2);
-            for (hits, bits) in hits.iter_mut().zip(bits) {
-                hits[held % GROUP] = bits & tail;
+            for ((hits, bits), &own) in hits.iter_mut().zip(bits).zip(&own) {
+                // The particle itself lies in the first range (its own row): a hit that is
+                // never a neighbour, dropped here rather than taken and thrown away.
+                let itself = if r == 0 { not_at(own, s) } else { u8::MAX };
+                hits[held % GROUP] = bits & tail & itself;
             }
             starts[held % GROUP] = s;
             held += 1;
@@ -395,6 +404,17 @@ fn test_ranges<const P: usize>(
             me,
             &mut |j, d2| hit(p, j, d2),
         );
+    }
+}
+
+/// All bits of a piece starting at `s` but particle `own`'s.
+#[inline(always)]
+fn not_at(own: usize, s: u32) -> u8 {
+    let offset = own.wrapping_sub(s as usize);
+    if offset < SHORT {
+        !(1 << offset)
+    } else {
+        u8::MAX
     }
 }
 
