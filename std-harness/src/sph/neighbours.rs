@@ -368,16 +368,7 @@ fn test_ranges<const P: usize>(
         // Bounded: `s` moves on by SHORT a pass until it reaches `e`.
         loop {
             if held == GROUP {
-                for (p, (hits, me)) in hits.iter_mut().zip(me).enumerate() {
-                    take_hits(
-                        u128::from_le_bytes(*hits),
-                        &starts,
-                        xyz,
-                        me,
-                        &mut |j, d2| hit(p, j, d2),
-                    );
-                    *hits = [0; GROUP];
-                }
+                take_held(&mut hits, &starts, xyz, me, hit);
                 held = 0;
             }
             let tail = TAIL[((e - s) as usize).min(SHORT)];
@@ -396,14 +387,23 @@ fn test_ranges<const P: usize>(
             }
         }
     }
-    for (p, (hits, me)) in hits.iter().zip(me).enumerate() {
-        take_hits(
-            u128::from_le_bytes(*hits),
-            &starts,
-            xyz,
-            me,
-            &mut |j, d2| hit(p, j, d2),
-        );
+    take_held(&mut hits, &starts, xyz, me, hit);
+}
+
+/// Takes the hits held for each particle `p` (calling `hit(p, j, r²)`), and clears them.
+#[inline(always)]
+fn take_held<const P: usize>(
+    hits: &mut [[u8; GROUP]; P],
+    starts: &[u32; GROUP],
+    xyz: (&[f32], &[f32], &[f32]),
+    me: [[f32; 3]; P],
+    hit: &mut impl FnMut(usize, usize, f32),
+) {
+    for (p, (hits, me)) in hits.iter_mut().zip(me).enumerate() {
+        take_hits(u128::from_le_bytes(*hits), starts, xyz, me, &mut |j, d2| {
+            hit(p, j, d2)
+        });
+        *hits = [0; GROUP];
     }
 }
 
