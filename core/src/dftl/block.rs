@@ -24,8 +24,9 @@ use crate::math::{Math, Real, Vec3};
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
-use super::lane::{Lane, Wide, WideMask, V3};
+use super::lane::{Lane, Wide, WideMask, Q, V3};
 use super::{advance, velocity, Chain, Measures, NodeInput, Setup, Tally};
+use crate::collide::MAX_COLLIDERS;
 
 /// Lanes per block the harness should use on x86-64: measured fastest — on the SSE2 baseline
 /// 16 lanes ran ≈ 2.5× faster than 8 and than 32 (both spill far more), and with
@@ -285,6 +286,12 @@ fn store<const W: usize>(v: &mut VecLanes<W>, value: V3<Wide<W>>) {
 }
 
 /// 0 where every component of `v` is finite, NaN otherwise (`x − x`).
+///
+/// The pass checks velocities only: a node's new velocity is `(x* − x)/Δt − (s_d/Δt) c` (or
+/// `(target − x)/Δt` for a held node), and with `x` finite (the last step's guard saw to
+/// that) and `1/Δt` finite and positive, a non-finite `x*` makes it non-finite too (`±∞` stays
+/// `±∞` or meets `∓∞` and turns NaN; NaN stays NaN) — so the positions need no check of their
+/// own, and a non-finite old `x` is caught the same way.
 #[inline(always)]
 #[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
 fn not_finite<T: Lane>(v: V3<T>) -> T {
@@ -319,15 +326,17 @@ fn pass<
     let zero = Wide::splat(0.0);
     // 0 while every value a lane wrote is finite.
     let mut poison = zero;
-    // Line 12's root: nodes 0 and 1 follow the head, as in the rod solver.
+    // Line 12's root: nodes 0 and 1 follow the head, as in the rod solver
+    // (`rod::step::held_node`, the same operations on every lane).
+    let head_rotation = Q::<Wide<W>>::splat(ctx.head.rotation);
+    let head_position = V3::splat(ctx.head.position);
+    let inv_dt = Wide::splat(ctx.inv_dt);
     for (state, shape) in block.state.iter_mut().zip(&block.shape).take(2) {
-        for l in 0..W {
-            let rest = get(&shape.rest_position, l);
-            let (x, v) = crate::rod::step::held_node(ctx, rest, get(&state.position, l));
-            set(&mut state.position, l, x);
-            set(&mut state.velocity, l, v);
-        }
-        poison = poison + not_finite(load(&state.position)) + not_finite(load(&state.velocity));
+        let target = head_rotation.rotate(load(&shape.rest_position)) + head_position;
+        let velocity = (target - load(&state.position)).scale(inv_dt);
+        store(&mut state.position, target);
+        store(&mut state.velocity, velocity);
+        poison = poison + not_finite(velocity);
     }
     let max_nodes = block.max_nodes.min(N);
     if max_nodes < 3 {
@@ -368,24 +377,26 @@ fn pass<
         let v_new = V3::select(longest, v_new, old_velocity);
         store(&mut last.position, x_new);
         store(&mut last.velocity, v_new);
-        poison = poison + not_finite(x_new) + not_finite(v_new);
+        poison = poison + not_finite(v_new);
     }
+    let (stretch, contact_stretch) = measures.stretches::<M>();
     for l in 0..block.strands.min(W) {
-        let lane = |v: V3<Wide<W>>| V3 {
-            x: v.x.0[l],
-            y: v.y.0[l],
-            z: v.z.0[l],
+        // The pushes are only read with colliders in the scene: no lane gathering without.
+        let collider_push = if setup.collisions {
+            measures
+                .collider_push
+                .map(|v| Vec3::new(v.x.0[l], v.y.0[l], v.z.0[l]))
+        } else {
+            [Vec3::ZERO; MAX_COLLIDERS]
         };
-        let one = Measures {
-            stretched: measures.stretched.0[l],
-            compressed: measures.compressed.0[l],
-            contact_stretched: measures.contact_stretched.0[l],
-            contact_compressed: measures.contact_compressed.0[l],
+        let tally = Tally {
+            stretch: stretch.0[l],
+            contact_stretch: contact_stretch.0[l],
             penetration: measures.penetration.0[l],
-            contacts: measures.contacts.0[l],
-            collider_push: measures.collider_push.map(lane),
+            contacts: measures.contacts.0[l] as u32,
+            collider_push,
         };
-        Tally::from_measures::<M>(&one).report(report, setup.collisions, setup.inv_dt);
+        tally.report(report, setup.collisions, setup.inv_dt);
     }
     core::array::from_fn(|l| poison.0[l] == 0.0)
 }
@@ -478,7 +489,7 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     let v_new = V3::select(finishing, v_new, old_velocity);
     store(&mut previous.position, x_new);
     store(&mut previous.velocity, v_new);
-    *carried.poison = *carried.poison + not_finite(x_new) + not_finite(v_new);
+    *carried.poison = *carried.poison + not_finite(v_new);
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }

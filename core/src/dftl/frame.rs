@@ -31,6 +31,11 @@ pub fn from_x_axis<M: Math>(t: Vec3) -> Quat {
 /// `n_i = c n + k × n + k (k·n)/(1 + c)` with `c = t_{i−1}·t_i` (the factor
 /// `(1 − c)/|k|² = 1/(1 + c)` for unit tangents). A half turn (`1 + c` ≤ 1e-6) has no unique
 /// minimal rotation: the normal stays, still perpendicular to `t_i = −t_{i−1}`.
+///
+/// On a normal perpendicular to `t_{i−1}` the rotation also reduces to the two-reflection
+/// form `n − (t_i·n)/(1 + c) (t_{i−1} + t_i)`, half the arithmetic; measured on the 16-lane
+/// blocks (SSE2) it ran 7–10 % slower than this form (1,024 × 32 and 4,096 × 64, session 7),
+/// whose independent terms overlap the division, so this one stays.
 #[inline(always)]
 #[must_use]
 pub fn transport<T: Lane>(tangent: V3<T>, normal: V3<T>, t: V3<T>) -> V3<T> {
@@ -46,4 +51,66 @@ pub fn transport<T: Lane>(tangent: V3<T>, normal: V3<T>, t: V3<T>) -> V3<T> {
 #[must_use]
 pub fn rotate<T: Lane>(tangent: V3<T>, normal: V3<T>, v: V3<T>) -> V3<T> {
     tangent.scale(v.x) + normal.scale(v.y) + tangent.cross(normal).scale(v.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::{Libm, Math};
+
+    /// Rodrigues' rotation about `t_{i−1} × t_i` by the angle between the tangents, the
+    /// textbook form of the minimal rotation, in f64.
+    fn rodrigues(a: [f64; 3], b: [f64; 3], v: [f64; 3]) -> [f64; 3] {
+        let cross = |p: [f64; 3], q: [f64; 3]| {
+            [
+                p[1] * q[2] - p[2] * q[1],
+                p[2] * q[0] - p[0] * q[2],
+                p[0] * q[1] - p[1] * q[0],
+            ]
+        };
+        let dot = |p: [f64; 3], q: [f64; 3]| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
+        let k = cross(a, b);
+        let s = dot(k, k).sqrt();
+        let c = dot(a, b);
+        let axis = k.map(|x| x / s);
+        let axv = cross(axis, v);
+        let along = dot(axis, v) * (1.0 - c);
+        core::array::from_fn(|i| v[i] * c + axv[i] * s + axis[i] * along)
+    }
+
+    #[test]
+    fn transport_is_the_minimal_rotation_along_a_helix_and_a_fold() {
+        let mut worst: f64 = 0.0;
+        let mut tilt: f32 = 0.0;
+        let mut t = Vec3::new(0.0, -1.0, 0.0);
+        let mut n = Vec3::new(1.0, 0.0, 0.0);
+        let unit = |v: Vec3| v * (1.0 / Libm::length(v));
+        // A helix of 200 edges turning 0.3 rad per edge, then a fold of about 150°.
+        for i in 0..201 {
+            let (sin, cos) = Libm::sin_cos(0.3 * i as f32);
+            let next = if i == 200 {
+                unit(-t + Vec3::new(0.0, 0.0, 0.6))
+            } else {
+                unit(Vec3::new(0.4 * cos, -1.0, 0.4 * sin))
+            };
+            let want = rodrigues(
+                t.to_array().map(f64::from),
+                next.to_array().map(f64::from),
+                n.to_array().map(f64::from),
+            );
+            n = transport(t.into(), n.into(), next.into()).into();
+            for (got, want) in n.to_array().into_iter().zip(want) {
+                worst = worst.max((f64::from(got) - want).abs());
+            }
+            tilt = tilt.max(n.dot(next).abs());
+            t = next;
+        }
+        assert!(worst < 1e-6, "differs from Rodrigues by {worst}");
+        assert!(tilt < 1e-6, "normal tilted {tilt} towards the tangent");
+        assert!(
+            (n.length() - 1.0).abs() < 1e-5,
+            "normal length {}",
+            n.length()
+        );
+    }
 }

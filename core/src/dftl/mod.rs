@@ -393,21 +393,41 @@ pub struct Tally {
 }
 
 /// The relative stretch `δ` of a strain `s = δ + δ²/2`: `δ = 2s / (1 + √(1 + 2s))` (the form
-/// without cancellation for small `s`).
-fn relative_stretch<M: Math>(strain: Real) -> Real {
-    2.0 * strain / (1.0 + M::sqrt((1.0 + 2.0 * strain).max(0.0)))
+/// without cancellation for small `s`), on lanes so a block turns all its strands' strains at
+/// once.
+#[inline(always)]
+fn relative_stretch<M: Math, T: Lane>(strain: T) -> T {
+    let (one, two) = (T::splat(1.0), T::splat(2.0));
+    two * strain / (one + (one + two * strain).max(T::splat(0.0)).sqrt::<M>())
+}
+
+/// The largest `|δ|` of the strains between `−down` and `up`: `δ(s)` grows with `s`, so it is
+/// at one end or the other.
+#[inline(always)]
+fn largest_stretch<M: Math, T: Lane>(up: T, down: T) -> T {
+    relative_stretch::<M, T>(up).max(-relative_stretch::<M, T>(-down))
+}
+
+impl<T: Lane> Measures<T> {
+    /// The largest relative stretch of a segment without and with a pushed node, per lane.
+    #[inline(always)]
+    #[must_use]
+    pub fn stretches<M: Math>(&self) -> (T, T) {
+        (
+            largest_stretch::<M, T>(self.stretched, self.compressed),
+            largest_stretch::<M, T>(self.contact_stretched, self.contact_compressed),
+        )
+    }
 }
 
 impl Tally {
-    /// One lane's measures as the report gives them. `δ(s)` grows with `s`, so the largest
-    /// `|δ|` is at the largest or the most negative strain.
+    /// One lane's measures as the report gives them, with its `stretches` (from
+    /// [`Measures::stretches`]).
     #[must_use]
-    pub fn from_measures<M: Math>(m: &Measures<Real>) -> Self {
-        let stretch =
-            |up: Real, down: Real| relative_stretch::<M>(up).max(-relative_stretch::<M>(-down));
+    pub fn from_measures(m: &Measures<Real>, (stretch, contact_stretch): (Real, Real)) -> Self {
         Tally {
-            stretch: stretch(m.stretched, m.compressed),
-            contact_stretch: stretch(m.contact_stretched, m.contact_compressed),
+            stretch,
+            contact_stretch,
             penetration: m.penetration,
             contacts: m.contacts as u32,
             collider_push: m.collider_push.map(Vec3::from),
@@ -505,7 +525,11 @@ pub fn step<M: Math, const N: usize>(
     );
     state.position[n - 1] = x_new.into();
     state.velocity[n - 1] = v_new.into();
-    Tally::from_measures::<M>(&measures).report(report, setup.collisions, setup.inv_dt);
+    Tally::from_measures(&measures, measures.stretches::<M>()).report(
+        report,
+        setup.collisions,
+        setup.inv_dt,
+    );
 }
 
 #[cfg(test)]
