@@ -361,10 +361,13 @@ fn pass<
             previous_contact: &mut previous_contact,
             poison: &mut poison,
         };
-        if k > 2 && k < common {
-            node::<M, W, N, true>(ctx, &setup, block, k, nodes_real, accelerations, carried);
-        } else {
-            node::<M, W, N, false>(ctx, &setup, block, k, nodes_real, accelerations, carried);
+        // Node 2 finishes nothing (node 1 is held); past the shortest lane the masks select.
+        let (b, a, n) = (&mut *block, accelerations, nodes_real);
+        match (k == 2, k < common) {
+            (true, true) => node::<M, W, N, true, false>(ctx, &setup, b, k, n, a, carried),
+            (true, false) => node::<M, W, N, false, false>(ctx, &setup, b, k, n, a, carried),
+            (false, true) => node::<M, W, N, true, true>(ctx, &setup, b, k, n, a, carried),
+            (false, false) => node::<M, W, N, false, true>(ctx, &setup, b, k, n, a, carried),
         }
     }
     // The last node of the longest lanes: no correction.
@@ -409,11 +412,11 @@ struct Carried<'a, const W: usize> {
     poison: &'a mut Wide<W>,
 }
 
-/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`.
-/// With `ALL` every lane has nodes `k − 1` and `k` (and `k > 2`): the masks are constants.
+/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and, with `FINISH` (`k > 2`), lines
+/// 24–26 for node `k − 1`. With `ALL` every lane has node `k`: the masks are constants.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn node<M: Math, const W: usize, const N: usize, const ALL: bool>(
+fn node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: bool>(
     ctx: &StepContext,
     setup: &Setup,
     block: &mut DftlBlock<W, N>,
@@ -438,7 +441,7 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool>(
         // Node k − 1 exists in this lane and is free: it is finished now.
         (
             node_index.lt(nodes_real),
-            Wide::<W>::mask(k > 2) & (node_index - Wide::splat(1.0)).lt(nodes_real),
+            (node_index - Wide::splat(1.0)).lt(nodes_real),
         )
     };
     let (extra, has_extra) = match accelerations {
@@ -481,15 +484,17 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     );
     // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
     let next_correction = V3::select(active, next.correction, V3::zero());
-    let old_position = load(&previous.position);
-    let old_velocity = load(&previous.velocity);
-    let (x_new, v_new) =
-        velocity::finish(setup, carried.chain.position, old_position, next_correction);
-    let x_new = V3::select(finishing, x_new, old_position);
-    let v_new = V3::select(finishing, v_new, old_velocity);
-    store(&mut previous.position, x_new);
-    store(&mut previous.velocity, v_new);
-    *carried.poison = *carried.poison + not_finite(v_new);
+    if FINISH {
+        let old_position = load(&previous.position);
+        let old_velocity = load(&previous.velocity);
+        let (x_new, v_new) =
+            velocity::finish(setup, carried.chain.position, old_position, next_correction);
+        let x_new = V3::select(finishing, x_new, old_position);
+        let v_new = V3::select(finishing, v_new, old_velocity);
+        store(&mut previous.position, x_new);
+        store(&mut previous.velocity, v_new);
+        *carried.poison = *carried.poison + not_finite(v_new);
+    }
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }
