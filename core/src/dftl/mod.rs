@@ -421,10 +421,11 @@ impl<T: Lane> Measures<T> {
 }
 
 impl Tally {
-    /// One lane's measures as the report gives them, with its `stretches` (from
-    /// [`Measures::stretches`]).
+    /// One strand's measures as the report gives them (a block builds its lanes' tallies
+    /// from [`Measures::stretches`] of all lanes at once).
     #[must_use]
-    pub fn from_measures(m: &Measures<Real>, (stretch, contact_stretch): (Real, Real)) -> Self {
+    pub fn from_measures<M: Math>(m: &Measures<Real>) -> Self {
+        let (stretch, contact_stretch) = m.stretches::<M>();
         Tally {
             stretch,
             contact_stretch,
@@ -525,11 +526,7 @@ pub fn step<M: Math, const N: usize>(
     );
     state.position[n - 1] = x_new.into();
     state.velocity[n - 1] = v_new.into();
-    Tally::from_measures(&measures, measures.stretches::<M>()).report(
-        report,
-        setup.collisions,
-        setup.inv_dt,
-    );
+    Tally::from_measures::<M>(&measures).report(report, setup.collisions, setup.inv_dt);
 }
 
 #[cfg(test)]
