@@ -53,6 +53,8 @@ pub struct BendingSystem<const N: usize> {
     band: [[BandRow; 3]; N],
     inverse_pivot: [[Real; 3]; N],
     nodes: usize,
+    /// Smallest pivot [`Self::factor`] accepts: half the lightest unknown node's mass.
+    pivot_floor: Real,
 }
 
 impl<const N: usize> Default for BendingSystem<N> {
@@ -61,9 +63,15 @@ impl<const N: usize> Default for BendingSystem<N> {
             band: [[[0.0; BAND + 1]; 3]; N],
             inverse_pivot: [[0.0; 3]; N],
             nodes: 0,
+            pivot_floor: 0.0,
         }
     }
 }
+
+/// Smallest pivot the factorisation keeps, relative to its row's diagonal: 2⁻²⁰, eight units
+/// in the last place of an f32 (a pivot smaller than that is what is left of the diagonal
+/// after cancellation, rounding noise; see `factor_row`).
+pub const PIVOT_RESOLUTION: Real = 1.0 / 1_048_576.0;
 
 /// First unknown row: nodes 0 and 1 are held by the head.
 const FIRST_ROW: usize = 6;
@@ -309,7 +317,12 @@ fn add_block<const OFFSET: usize>(rows: &mut [BandRow; 3], block: &[[Real; 3]; 3
 /// One row `r ≥ BAND` of the `L D Lᵀ` factorisation: `previous[k]` is the factored row
 /// `r − BAND + k`, `inverse_pivot[k]` its `1/D`. Returns `1/D(r)`.
 #[inline(always)]
-fn factor_row(row: &mut BandRow, previous: &[BandRow; BAND], inverse_pivot: &[Real; BAND]) -> Real {
+fn factor_row(
+    row: &mut BandRow,
+    previous: &[BandRow; BAND],
+    inverse_pivot: &[Real; BAND],
+    mass_floor: Real,
+) -> Real {
     // ld[m] = L(r, r − m) D(r − m), filled from the farthest column in. (Exclusive ranges:
     // `a..=b` iterates with an extra check per step.)
     let mut ld = [0.0; BAND + 1];
@@ -322,12 +335,37 @@ fn factor_row(row: &mut BandRow, previous: &[BandRow; BAND], inverse_pivot: &[Re
         ld[m] = sum;
         row[m] = sum * inverse_pivot[BAND - m];
     }
-    let mut pivot = row[0];
+    let diagonal = row[0];
+    let mut pivot = diagonal;
     for m in 1..BAND + 1 {
         pivot -= row[m] * ld[m];
     }
+    // Each pivot of `M + h² H̃` (H̃ positive semi-definite) is a Schur complement, so at least
+    // the smallest eigenvalue and at least the lightest node's mass. Where `h² H̃` dwarfs `M`
+    // by more than f32 resolves (a hairpin fold: `|κb| ≈ 400`, diagonal entries 1e13 times
+    // the mass), the subtraction above cancels to rounding noise, and a pivot near zero or
+    // below turned the step into NaN. A pivot under [`PIVOT_RESOLUTION`] of its diagonal is
+    // that noise: it is floored there (and never below half the lightest mass), as in a
+    // modified Cholesky factorisation. The factor stays positive definite and the solve
+    // finite; in that direction the step is stiffer than the model. A system f32 resolves
+    // never reaches the floor, so its bits are unchanged (every recorded hash holds).
+    let relative = PIVOT_RESOLUTION * diagonal;
+    // A comparison, not `f32::max`: that is a library call on the Cortex-M4F.
+    let floor = if relative > mass_floor {
+        relative
+    } else {
+        mass_floor
+    };
+    if pivot.is_nan() || pivot < floor {
+        pivot = floor;
+    }
     row[0] = pivot;
     1.0 / pivot
+}
+
+/// The smallest of `mass` beyond the held nodes 0 and 1 (∞ when there is none).
+fn lightest(mass: &[Real]) -> Real {
+    mass.iter().skip(2).fold(Real::INFINITY, |m, x| m.min(*x))
 }
 
 impl<const N: usize> BendingSystem<N> {
@@ -342,6 +380,7 @@ impl<const N: usize> BendingSystem<N> {
     ) {
         let nodes = frames.nodes.min(N);
         self.nodes = nodes;
+        self.pivot_floor = 0.5 * lightest(&mass[..nodes]);
         for (i, rows) in self.band.iter_mut().enumerate().take(nodes) {
             let diagonal = if i >= 2 { mass[i] } else { 1.0 };
             let mut row = [0.0; BAND + 1];
@@ -440,6 +479,7 @@ impl<const N: usize> BendingSystem<N> {
         let band = self.band.as_flattened_mut();
         let inverse_pivot = self.inverse_pivot.as_flattened_mut();
         let rows = (3 * self.nodes).min(band.len()).min(inverse_pivot.len());
+        let floor = self.pivot_floor;
         for slot in inverse_pivot.iter_mut().take(FIRST_ROW) {
             *slot = 1.0;
         }
@@ -455,7 +495,7 @@ impl<const N: usize> BendingSystem<N> {
                 <&[Real; BAND]>::try_from(&pivots_done[start..]),
             );
             *pivot = match windows {
-                (Ok(previous), Ok(pivots)) => factor_row(row, previous, pivots),
+                (Ok(previous), Ok(pivots)) => factor_row(row, previous, pivots, floor),
                 // The first rows (r < BAND): the same with a shorter reach.
                 _ => {
                     let mut previous = [[0.0; BAND + 1]; BAND];
@@ -465,7 +505,7 @@ impl<const N: usize> BendingSystem<N> {
                         previous[BAND - reach + k] = done[start + k];
                         pivots[BAND - reach + k] = pivots_done[start + k];
                     }
-                    factor_row(row, &previous, &pivots)
+                    factor_row(row, &previous, &pivots, floor)
                 }
             };
         }

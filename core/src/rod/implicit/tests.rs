@@ -326,3 +326,41 @@ fn banded_solve_matches_the_dense_system() {
     println!("banded solve: residual {worst:e} of {scale:e}");
     assert!(worst < 1e-3 * scale, "{worst:e} of {scale:e}");
 }
+
+#[test]
+fn a_hairpin_fold_factors_to_finite_positive_pivots() {
+    // Folded back at node 5 to a turning angle of π − 0.01 rad: `h² H̃` outweighs the masses
+    // by ~1e13 there, beyond f32, and the unfloored factorisation turned the step into NaN.
+    let straight: Vec<Vec3> = (0..NODES)
+        .map(|i| Vec3::new(0.01 * i as f32, 0.0, 0.0))
+        .collect();
+    let strand = Strand::<NODES>::from_polyline(&straight, &Material::HUMAN_HAIR).unwrap();
+    let back = Vec3::new(-(0.01f32.cos()), 0.01f32.sin(), 0.0);
+    let mut folded = straight.clone();
+    for i in 6..NODES {
+        folded[i] = folded[5] + back * (0.01 * (i - 5) as f32);
+    }
+    let mut system = system_at(&strand, &folded, false);
+    let largest_diagonal = system
+        .band
+        .as_flattened()
+        .iter()
+        .fold(0.0f32, |m, row| m.max(row[0]));
+    assert!(
+        largest_diagonal > 1e6 * strand.rest.mass[5],
+        "{largest_diagonal}"
+    );
+    system.factor();
+    for (r, inverse) in system.inverse_pivot.as_flattened().iter().enumerate() {
+        assert!(
+            inverse.is_finite() && *inverse > 0.0,
+            "row {r}: 1/D = {inverse}"
+        );
+    }
+    let mut rhs = [[0.0; 3]; NODES];
+    for (i, row) in rhs.iter_mut().enumerate().skip(2) {
+        *row = (strand.rest.mass[i] * Vec3::new(0.1, -0.2, 0.05) * i as f32).to_array();
+    }
+    system.solve(&mut rhs);
+    assert!(rhs.as_flattened().iter().all(|v| v.is_finite()), "{rhs:?}");
+}
