@@ -24,8 +24,23 @@ pub fn check<const N: usize>(
     index: u32,
     report: &mut StepReport,
 ) -> bool {
+    let good = strand.is_finite() && (!inextensible || within_reach(strand));
+    restore_unless(good, strand, last_good, index, report)
+}
+
+/// The guard with its verdict already known: a solver that watched every value it wrote (the
+/// DFTL step, [`crate::dftl::velocity::not_finite`]) says whether the strand is `good`, and a
+/// strand that is not goes back to `last_good` as in [`check`]. Returns whether it rolled
+/// back.
+pub fn restore_unless<const N: usize>(
+    good: bool,
+    strand: &mut Strand<N>,
+    last_good: &StrandState<N>,
+    index: u32,
+    report: &mut StepReport,
+) -> bool {
     report.ran(Stage::Guard);
-    if strand.is_finite() && (!inextensible || within_reach(strand)) {
+    if good {
         return false;
     }
     strand.state.clone_from(last_good);

@@ -44,24 +44,30 @@ pub fn step_strands<M: Math, const N: usize>(
         // 1. Keep the last good state (quarantine).
         report.ran(Stage::Snapshot);
         let last_good = strand.state.clone();
-        // 2. The solver's own stage list (Kmoch Alg. 1 or Sánchez-Banderas Alg. 1).
-        match ctx.params.solver {
-            Solver::Rod => crate::rod::step::step::<M, N>(
-                strand,
-                ctx,
-                grabs,
-                index,
-                strand_accelerations,
-                report,
-            ),
-            Solver::Dftl => crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report),
-        }
-        // 3. Guard: nothing non-finite leaves the step.
-        // DFTL keeps every segment at length by construction; the rod's projection can be
-        // outrun by a configuration past its stability limit, so only the rod checks reach.
-        let inextensible = matches!(ctx.params.solver, Solver::Rod)
-            && ctx.has(crate::effects::Effect::Inextensibility);
-        let rolled_back = crate::guard::check(strand, &last_good, inextensible, index, report);
+        // 2. The solver's own stage list (Kmoch Alg. 1 or Sánchez-Banderas Alg. 1), then
+        // 3. the guard: nothing non-finite leaves the step.
+        let rolled_back = match ctx.params.solver {
+            Solver::Rod => {
+                crate::rod::step::step::<M, N>(
+                    strand,
+                    ctx,
+                    grabs,
+                    index,
+                    strand_accelerations,
+                    report,
+                );
+                // The rod's projection can be outrun by a configuration past its stability
+                // limit, so the rod also checks reach.
+                let inextensible = ctx.has(crate::effects::Effect::Inextensibility);
+                crate::guard::check(strand, &last_good, inextensible, index, report)
+            }
+            Solver::Dftl => {
+                // DFTL keeps every segment at length by construction, and watches what it
+                // writes: no second pass over the strand.
+                let good = crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report);
+                crate::guard::restore_unless(good, strand, &last_good, index, report)
+            }
+        };
         // 4. A rod strand the explicit bending substeps lost takes the implicit step from now
         // on (`RodRest::implicit_bending`).
         if rolled_back && ctx.params.solver == Solver::Rod {

@@ -285,19 +285,6 @@ fn store<const W: usize>(v: &mut VecLanes<W>, value: V3<Wide<W>>) {
     *v = [value.x.0, value.y.0, value.z.0];
 }
 
-/// 0 where every component of `v` is finite, NaN otherwise (`x − x`).
-///
-/// The pass checks velocities only: a node's new velocity is `(x* − x)/Δt − (s_d/Δt) c` (or
-/// `(target − x)/Δt` for a held node), and with `x` finite (the last step's guard saw to
-/// that) and `1/Δt` finite and positive, a non-finite `x*` makes it non-finite too (`±∞` stays
-/// `±∞` or meets `∓∞` and turns NaN; NaN stays NaN) — so the positions need no check of their
-/// own, and a non-finite old `x` is caught the same way.
-#[inline(always)]
-#[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
-fn not_finite<T: Lane>(v: V3<T>) -> T {
-    (v.x - v.x) + (v.y - v.y) + (v.z - v.z)
-}
-
 /// The whole pass over the nodes of a block with the effect switches fixed. Returns which
 /// lanes stayed finite.
 #[inline(never)]
@@ -336,7 +323,7 @@ fn pass<
         let velocity = (target - load(&state.position)).scale(inv_dt);
         store(&mut state.position, target);
         store(&mut state.velocity, velocity);
-        poison = poison + not_finite(velocity);
+        poison = poison + velocity::not_finite(velocity);
     }
     let max_nodes = block.max_nodes.min(N);
     if max_nodes < 3 {
@@ -380,7 +367,7 @@ fn pass<
         let v_new = V3::select(longest, v_new, old_velocity);
         store(&mut last.position, x_new);
         store(&mut last.velocity, v_new);
-        poison = poison + not_finite(v_new);
+        poison = poison + velocity::not_finite(v_new);
     }
     let (stretch, contact_stretch) = measures.stretches::<M>();
     for l in 0..block.strands.min(W) {
@@ -399,7 +386,7 @@ fn pass<
             contacts: measures.contacts.0[l] as u32,
             collider_push,
         };
-        tally.report(report, setup.collisions, setup.inv_dt);
+        tally.report(report, ctx.colliders().len(), setup.inv_dt);
     }
     core::array::from_fn(|l| poison.0[l] == 0.0)
 }
@@ -493,7 +480,7 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: 
         let v_new = V3::select(finishing, v_new, old_velocity);
         store(&mut previous.position, x_new);
         store(&mut previous.velocity, v_new);
-        *carried.poison = *carried.poison + not_finite(v_new);
+        *carried.poison = *carried.poison + velocity::not_finite(v_new);
     }
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);

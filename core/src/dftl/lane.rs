@@ -37,6 +37,13 @@ pub trait Lane:
     /// running maximum keeps its value). A compare and a select: `f32::max` is a library
     /// call on the Cortex-M4F (no `VMAXNM`) and a five-instruction NaN fix-up on SSE2.
     fn max(self, other: Self) -> Self;
+    /// `self.max(select(mask, value, 0))`: a running maximum (≥ 0) fed where `mask` is set.
+    /// (A branch instead of the select made the scalar DFTL step 7 % dearer on the
+    /// Cortex-M4F: the selects compile to predicated moves.)
+    #[inline(always)]
+    fn max_where(self, mask: Self::Mask, value: Self) -> Self {
+        self.max(Self::select(mask, value, Self::splat(0.0)))
+    }
     /// `self < other` per lane.
     fn lt(self, other: Self) -> Self::Mask;
     /// Whether each lane is finite.

@@ -316,11 +316,17 @@ pub fn advance<M: Math, T: Lane>(
             x = pushed;
             contact = contact | inside;
         }
-        for shape in colliders {
-            let depth = collisions::depth::<M, T>(shape, x);
-            measures.penetration = measures.penetration.max(T::select(active, depth, zero));
+        // A node no collider pushed passed every collider's inside test where it now is:
+        // it is outside them all (at most an ulp inside the radius, rounding), so only the
+        // pushed ones are measured.
+        let pushed = active & contact;
+        if T::any(pushed) {
+            for shape in colliders {
+                let depth = collisions::depth::<M, T>(shape, x);
+                measures.penetration = measures.penetration.max_where(pushed, depth);
+            }
         }
-        measures.contacts = measures.contacts + T::select(active & contact, T::splat(1.0), zero);
+        measures.contacts = measures.contacts + T::select(pushed, T::splat(1.0), zero);
     }
     // The segment's strain, no square root: `(|e|² − l²)/(2l²) = δ + δ²/2` for the relative
     // stretch δ (turned into δ once per strand, [`Tally::from_measures`]).
@@ -331,18 +337,14 @@ pub fn advance<M: Math, T: Lane>(
         let touched = contact | previous_contact;
         let free = active & !touched;
         let pushed = active & touched;
-        measures.stretched = measures.stretched.max(T::select(free, strain, zero));
-        measures.compressed = measures.compressed.max(T::select(free, -strain, zero));
-        measures.contact_stretched = measures
-            .contact_stretched
-            .max(T::select(pushed, strain, zero));
-        measures.contact_compressed = measures
-            .contact_compressed
-            .max(T::select(pushed, -strain, zero));
+        measures.stretched = measures.stretched.max_where(free, strain);
+        measures.compressed = measures.compressed.max_where(free, -strain);
+        measures.contact_stretched = measures.contact_stretched.max_where(pushed, strain);
+        measures.contact_compressed = measures.contact_compressed.max_where(pushed, -strain);
     } else {
         // No collider, no contact: the contact extremes stay 0 in both forms.
-        measures.stretched = measures.stretched.max(T::select(active, strain, zero));
-        measures.compressed = measures.compressed.max(T::select(active, -strain, zero));
+        measures.stretched = measures.stretched.max_where(active, strain);
+        measures.compressed = measures.compressed.max_where(active, -strain);
     }
     // Line 21: the frame, carried only when the shape constraints need it. The tangent from
     // follow-the-leader holds unless a collider moved the node (or there was no projection).
@@ -437,37 +439,44 @@ impl Tally {
 
     /// Folds the tally into `report`: maxima and counts, and each collider's contact force
     /// `−Σ m Δx^push / Δt²` (the hair's push on the collider, as the rod solver reports it),
-    /// added strand by strand in strand order.
-    pub fn report(&self, report: &mut StepReport, collisions: bool, inv_dt: Real) {
-        report.max_stretch = report.max_stretch.max(self.stretch);
-        report.max_contact_stretch = report.max_contact_stretch.max(self.contact_stretch);
-        report.max_penetration = report.max_penetration.max(self.penetration);
+    /// added strand by strand in strand order, for the scene's first `colliders` colliders (0
+    /// with collisions off; the others have no push to add).
+    pub fn report(&self, report: &mut StepReport, colliders: usize, inv_dt: Real) {
+        // `Lane::max`, a compare: `f32::max` is a library call on the Cortex-M4F.
+        report.max_stretch = Lane::max(report.max_stretch, self.stretch);
+        report.max_contact_stretch = Lane::max(report.max_contact_stretch, self.contact_stretch);
+        report.max_penetration = Lane::max(report.max_penetration, self.penetration);
         report.contacts += self.contacts;
-        if collisions {
-            let scale = -(inv_dt * inv_dt);
-            for (force, push) in report.collider_forces.iter_mut().zip(self.collider_push) {
-                *force += push * scale;
-            }
+        let scale = -(inv_dt * inv_dt);
+        let forces = report.collider_forces.iter_mut().zip(self.collider_push);
+        for (force, push) in forces.take(colliders) {
+            *force += push * scale;
         }
     }
 }
 
 /// Steps one strand by `ctx.dt` (SB15 Algorithm 1, local dynamics). `accelerations` (if any)
 /// are the caller's per-node accelerations for this strand, indexed by node. Never panics;
-/// the caller's guard rolls back a strand that turns non-finite.
+/// returns whether every value it wrote is finite ([`velocity::not_finite`]), and the
+/// caller's guard rolls back a strand where it is not.
 pub fn step<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) {
+) -> bool {
     let setup = Setup::new(ctx);
     // Line 12's root: nodes 0 and 1 follow the head, exactly as in the rod solver.
     crate::rod::step::root_coupling(strand, ctx, report);
     setup.count_stages(ctx, accelerations.is_some(), 1, report);
+    // 0 while every velocity written is finite.
+    let mut poison: Real = 0.0;
+    for v in strand.state.velocity.iter().take(2) {
+        poison += velocity::not_finite(V3::from(*v));
+    }
     let n = strand.rest.nodes.min(N);
     if n < 3 {
-        return;
+        return poison == 0.0;
     }
     let rest = &strand.rest;
     let state = &mut strand.state;
@@ -513,6 +522,7 @@ pub fn step<M: Math, const N: usize>(
             );
             state.position[i - 1] = x_new.into();
             state.velocity[i - 1] = v_new.into();
+            poison += velocity::not_finite(v_new);
         }
         chain = next.chain;
         previous_contact = next.contact;
@@ -526,7 +536,9 @@ pub fn step<M: Math, const N: usize>(
     );
     state.position[n - 1] = x_new.into();
     state.velocity[n - 1] = v_new.into();
-    Tally::from_measures::<M>(&measures).report(report, setup.collisions, setup.inv_dt);
+    poison += velocity::not_finite(v_new);
+    Tally::from_measures::<M>(&measures).report(report, ctx.colliders().len(), setup.inv_dt);
+    poison == 0.0
 }
 
 #[cfg(test)]
