@@ -16,6 +16,31 @@ use hairsim_core::{
 
 /// Steps measured per scene.
 const STEPS: usize = 200;
+/// Steps per run when profiling one scene (a QEMU execution trace grows by ~7 MB per step).
+const PROFILE_STEPS: usize = 6;
+
+/// Set at build time (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape cargo build --release`): run only
+/// that scene, the 128-node rod or the 512-vertex DFTL one, for [`PROFILE_STEPS`] steps calm
+/// and violent, with [`step_begins`] and [`step_ends`] around each step, for
+/// `firmware/profile.py` to read a QEMU execution trace by (README, "Measured on the target").
+pub const PROFILE: Option<&str> = option_env!("HAIRSIM_PROFILE");
+
+/// Marks where a measured step starts in an execution trace (a call never inlined away).
+#[inline(never)]
+fn step_begins() {
+    // SAFETY: single-threaded; a volatile write keeps the call.
+    unsafe { core::ptr::write_volatile(core::ptr::addr_of_mut!(MARK), 1) }
+}
+
+/// Marks where a measured step ends.
+#[inline(never)]
+fn step_ends() {
+    // SAFETY: as in `step_begins`.
+    unsafe { core::ptr::write_volatile(core::ptr::addr_of_mut!(MARK), 0) }
+}
+
+/// Written by the step markers.
+static mut MARK: u32 = 0;
 
 /// Per-step tick counts of the scene being measured.
 static mut TICKS: [u32; STEPS] = [0; STEPS];
@@ -115,13 +140,14 @@ fn build<const S: usize, const N: usize, M: Math>(
     ok
 }
 
-/// Measures one scene and prints a line: solver, nodes, calm and violent min/median/max ticks.
+/// Measures one scene over `steps` steps (at most [`STEPS`]) and prints a line: solver,
+/// nodes, calm and violent min/median/max ticks.
 fn measure<const S: usize, const N: usize, M: Math>(
     world: &mut World<S, N, M>,
     solver: Solver,
-    strands: usize,
-    nodes: usize,
+    (strands, nodes): (usize, usize),
     shape: bool,
+    steps: usize,
 ) {
     let mut line = [(0u32, 0u32, 0u32); 2];
     for (v, violent) in [false, true].into_iter().enumerate() {
@@ -135,7 +161,8 @@ fn measure<const S: usize, const N: usize, M: Math>(
             return;
         }
         // SAFETY: the only access to TICKS: single-threaded, no interrupt touches it.
-        let t = unsafe { &mut *core::ptr::addr_of_mut!(TICKS) };
+        let all = unsafe { &mut *core::ptr::addr_of_mut!(TICKS) };
+        let t = &mut all[..steps.clamp(1, STEPS)];
         for (k, slot) in t.iter_mut().enumerate() {
             let time = (k + 1) as Real * world.params().dt;
             let head = if violent {
@@ -148,7 +175,9 @@ fn measure<const S: usize, const N: usize, M: Math>(
                 accelerations: None,
             };
             *slot = ticks(|| {
+                step_begins();
                 world.step(&input);
+                step_ends();
             });
         }
         line[v] = stats(t);
@@ -182,23 +211,37 @@ static mut SMALL_ROD: SmallRodWorld<crate::Vsqrt> = World::new();
 static mut DFTL: DftlWorld<crate::Vsqrt> = World::new();
 
 /// Runs every measurement: rod 16–256 nodes, DFTL 64–1024 vertices with and without shape
-/// preservation (`dftl`, `dftl_noshape`).
+/// preservation (`dftl`, `dftl_noshape`); or, when built with [`PROFILE`], that one scene.
 pub fn run() {
     // SAFETY: called once from `main`, nothing else touches these statics.
+    let small = unsafe { &mut *core::ptr::addr_of_mut!(SMALL_ROD) };
+    let rod = unsafe { &mut *core::ptr::addr_of_mut!(ROD) };
+    let dftl = unsafe { &mut *core::ptr::addr_of_mut!(DFTL) };
+    match PROFILE {
+        None => {}
+        Some("rod") => return measure(rod, Solver::Rod, (4, 32), false, PROFILE_STEPS),
+        Some("dftl") => return measure(dftl, Solver::Dftl, (32, 16), true, PROFILE_STEPS),
+        Some("dftl_noshape") => {
+            return measure(dftl, Solver::Dftl, (32, 16), false, PROFILE_STEPS);
+        }
+        Some(other) => {
+            return hprintln!(
+                "latency error: HAIRSIM_PROFILE={} (rod, dftl or dftl_noshape)",
+                other
+            );
+        }
+    }
     // One 16-node strand as well, in a world of that capacity: the largest rod scene that
     // fits half a tick lies below 32 nodes.
-    let small = unsafe { &mut *core::ptr::addr_of_mut!(SMALL_ROD) };
-    measure(small, Solver::Rod, 1, 16, false);
-    let rod = unsafe { &mut *core::ptr::addr_of_mut!(ROD) };
+    measure(small, Solver::Rod, (1, 16), false, STEPS);
     for strands in [1, 2, 4, 8] {
-        measure(rod, Solver::Rod, strands, 32, false);
+        measure(rod, Solver::Rod, (strands, 32), false, STEPS);
     }
-    let dftl = unsafe { &mut *core::ptr::addr_of_mut!(DFTL) };
     // DFTL with shape preservation (the scenes' default), then the same without it.
     for strands in [4, 8, 16, 32, 64] {
-        measure(dftl, Solver::Dftl, strands, 16, true);
+        measure(dftl, Solver::Dftl, (strands, 16), true, STEPS);
     }
     for strands in [4, 8, 16, 32, 64] {
-        measure(dftl, Solver::Dftl, strands, 16, false);
+        measure(dftl, Solver::Dftl, (strands, 16), false, STEPS);
     }
 }

@@ -68,7 +68,11 @@ static DFTL_WORLD: Mutex<RefCell<DftlWorld>> = Mutex::new(RefCell::new(World::ne
 
 #[entry]
 fn main() -> ! {
+    // A profiling build runs its one latency scene only (`latency::PROFILE`).
     let code = cortex_m::interrupt::free(|cs| {
+        if latency::PROFILE.is_some() {
+            return debug::EXIT_SUCCESS;
+        }
         let rod = run(&mut WORLD.borrow(cs).borrow_mut());
         let dftl = run_dftl(&mut DFTL_WORLD.borrow(cs).borrow_mut());
         if rod == debug::EXIT_SUCCESS {

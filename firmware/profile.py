@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""Where a step's instructions go on the Cortex-M4F: reads a QEMU execution trace of a
+profiling build (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape`, see `src/latency.rs`) and counts the
+instructions executed between the firmware's `step_begins` and `step_ends` markers, per
+function of the core (the innermost one, inlined or not) and per source line, and the
+dynamic share of VDIV/VSQRT and VFMA (against the static share `latency.py` assumes).
+
+    cd firmware && HAIRSIM_PROFILE=dftl_noshape cargo build --release
+    qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic -icount shift=0 \\
+      -semihosting-config enable=on,target=native -d in_asm,exec,nochain -D /tmp/trace.log \\
+      -kernel target/thumbv7em-none-eabihf/release/hairsim-firmware
+    python3 profile.py /tmp/trace.log target/thumbv7em-none-eabihf/release/hairsim-firmware
+
+Usage: profile.py TRACE ELF [ROWS]
+"""
+import collections
+import re
+import subprocess
+import sys
+
+
+def markers(elf):
+    """Entry addresses of the step markers: True where a step begins."""
+    out = subprocess.run(["llvm-nm", elf], check=True, capture_output=True, text=True).stdout
+    found = {}
+    for line in out.splitlines():
+        parts = line.split()
+        if len(parts) == 3 and ("step_begins" in parts[2] or "step_ends" in parts[2]):
+            found[int(parts[0], 16) & ~1] = "step_begins" in parts[2]
+    if len(found) != 2:
+        sys.exit("no step markers in the ELF: build with HAIRSIM_PROFILE set")
+    return found
+
+
+def read_trace(path, marks):
+    """Translated blocks (start → [(address, mnemonic)]) and, between the markers, how often
+    each block ran."""
+    blocks, runs = {}, collections.Counter()
+    block, inside = None, False
+    for line in open(path, errors="replace"):
+        if line.startswith("Trace"):
+            pc = int(re.search(r"\[[0-9a-f]+/([0-9a-f]+)/", line).group(1), 16)
+            inside = marks.get(pc, inside)
+            if inside:
+                runs[pc] += 1
+            block = None
+        elif line.startswith("IN:"):
+            block = []
+        elif block is not None:
+            m = re.match(r"0x([0-9a-f]+):\s+[0-9a-f]{4}(?: [0-9a-f]{4})?\s+(\S+)", line)
+            if m:
+                if not block:
+                    blocks[int(m.group(1), 16)] = block
+                block.append((int(m.group(1), 16), m.group(2)))
+            elif not line.strip():
+                block = None
+    return blocks, runs
+
+
+def main():
+    trace, elf = sys.argv[1], sys.argv[2]
+    rows = int(sys.argv[3]) if len(sys.argv) > 3 else 30
+    marks = markers(elf)
+    blocks, runs = read_trace(trace, marks)
+    steps = runs.get(min(a for a, begins in marks.items() if begins), 0)
+    per_address, ops = collections.Counter(), collections.Counter()
+    for pc, n in runs.items():
+        for address, mnemonic in blocks.get(pc, []):
+            per_address[address] += n
+            if mnemonic.startswith(("vdiv", "vsqrt")):
+                ops["divsqrt"] += n
+            elif mnemonic.startswith(("vfma", "vfms", "vfnma", "vfnms")):
+                ops["fma"] += n
+    total = sum(per_address.values())
+    if not total or not steps:
+        sys.exit("no step in the trace")
+    addresses = sorted(per_address)
+    out = subprocess.run(["llvm-symbolizer", "--obj=" + elf, "--inlining", "--functions=short"],
+                         input="\n".join(hex(a) for a in addresses), check=True,
+                         capture_output=True, text=True).stdout
+    by_function, by_line = collections.Counter(), collections.Counter()
+    for address, frames in zip(addresses, out.strip("\n").split("\n\n")):
+        lines = frames.split("\n")
+        pairs = [(lines[i], lines[i + 1]) for i in range(0, len(lines) - 1, 2)]
+        # Innermost frame in the core's own source (glam and core::ops fold into it).
+        core = [p for p in pairs if "/core/src/" in p[1] and "/library/core/" not in p[1]]
+        function, where = core[0] if core else pairs[0]
+        by_function[function] += per_address[address]
+        by_line["/".join(where.split("/")[-2:])] += per_address[address]
+    share = ops["divsqrt"] / total
+    print(f"{steps} steps, {total / steps:.0f} instructions per step; executed VDIV/VSQRT "
+          f"{100 * share:.2f} %, VFMA {100 * ops['fma'] / total:.2f} % -> "
+          f"{1 + 13 * share + 2 * ops['fma'] / total:.3f} cycles per instruction")
+    for title, counter in (("function", by_function), ("source line", by_line)):
+        print(f"\n| {title} | instructions per step | share |\n|---|---:|---:|")
+        for name, n in counter.most_common(rows):
+            print(f"| {name} | {n / steps:.0f} | {100 * n / total:.1f} % |")
+
+
+if __name__ == "__main__":
+    main()
