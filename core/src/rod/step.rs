@@ -115,16 +115,29 @@ pub fn step<M: Math, const N: usize>(
         ClampedSegments::ROOT_ONLY
     };
     let terms = elastic_terms(ctx);
-    let start = StepStart::<M>::capture(strand, &clamped, terms);
+    // One frames buffer for the step, recomputed in place as the centreline moves.
+    let mut frames = RodFrames::<M, N>::empty();
+    if terms.bending || terms.twist {
+        refresh_frames(&mut frames, strand);
+    }
+    let start = StepStart::<M>::capture(strand, &clamped, terms, &frames);
     // (1) elastic forces [bending, twist] and (2) external forces + symplectic Euler, substepped.
-    let angles = forces_and_integrate::<M, N>(strand, ctx, &clamped, terms, accelerations, report);
+    let angles = forces_and_integrate::<M, N>(
+        strand,
+        ctx,
+        &clamped,
+        terms,
+        &mut frames,
+        accelerations,
+        report,
+    );
     // (3) Root coupling: the head carries nodes 0 and 1, the root frame u^0 and θ^0.
     root_coupling_with_frame::<M, N>(strand, ctx, &start, report);
     // (4) Fast manifold projection [inextensibility, collisions, grabs] and velocity update.
     crate::projection::project_constraints::<M, N>(strand, ctx, grabs, strand_index, report);
     // (5) Twist [twist]: the Bishop frame in space for the new centreline, then θ.
     if ctx.has(Effect::Twist) {
-        update_twist::<M, N>(strand, ctx, &clamped, terms, &start, &angles, report);
+        update_twist::<M, N>(strand, ctx, &clamped, &mut frames, &start, &angles, report);
     }
 }
 
@@ -144,10 +157,13 @@ struct StepStart<M: Math> {
 }
 
 impl<M: Math> StepStart<M> {
+    /// `frames` are those of the strand's centreline (computed when `terms` has bending or
+    /// twist).
     fn capture<const N: usize>(
         strand: &Strand<N>,
         clamped: &ClampedSegments,
         terms: ElasticTerms,
+        frames: &RodFrames<M, N>,
     ) -> Self {
         if !(terms.bending || terms.twist) {
             return StepStart {
@@ -156,10 +172,10 @@ impl<M: Math> StepStart<M> {
             };
         }
         let x = &strand.state.position;
-        let clamped_frames = clamped.others().next().map(|_| {
-            let frames = strand_frames::<M, N>(strand);
-            ClampedFrames::save(&frames, &strand.state.theta, clamped)
-        });
+        let clamped_frames = clamped
+            .others()
+            .next()
+            .map(|_| ClampedFrames::save(frames, &strand.state.theta, clamped));
         StepStart {
             root_tangent: Some(unit::<M>(x[1] - x[0])),
             clamped_frames,
@@ -172,14 +188,14 @@ fn unit<M: Math>(v: Vec3) -> Vec3 {
     v * (1.0 / M::length(v))
 }
 
-/// The frames of the strand's current centreline.
-fn strand_frames<M: Math, const N: usize>(strand: &Strand<N>) -> RodFrames<M, N> {
+/// `frames` recomputed in place for the strand's current centreline.
+fn refresh_frames<M: Math, const N: usize>(frames: &mut RodFrames<M, N>, strand: &Strand<N>) {
     let n = strand.rest.nodes.min(N);
-    RodFrames::<M, N>::compute(
+    frames.recompute(
         &strand.state.position[..n],
         strand.state.root_frame,
         &strand.rest.rod.rest_length,
-    )
+    );
 }
 
 /// The fixed substeps per step for this strand: `⌈dt · FOLD_ALLOWANCE / (SAFETY · dt_max)⌉`,
@@ -312,25 +328,21 @@ fn forces_and_integrate<M: Math, const N: usize>(
     ctx: &StepContext,
     clamped: &ClampedSegments,
     terms: ElasticTerms,
+    frames: &mut RodFrames<M, N>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> [[Real; 2]; N] {
     let elastic = terms.bending || terms.twist;
     let fixed = substeps(&strand.rest.rod, ctx.dt, terms.bending);
     if terms.bending && (fixed >= IMPLICIT_FROM || strand.rest.rod.implicit_bending) {
-        return implicit_step::<M, N>(strand, ctx, clamped, terms, accelerations, report);
+        return implicit_step::<M, N>(strand, ctx, clamped, terms, frames, accelerations, report);
     }
-    // The frames of the shape the step starts from: they set the substep count and serve the
-    // first substep's forces.
-    let mut frames = elastic.then(|| strand_frames::<M, N>(strand));
-    // The sharpest fold's `1 + cos φ` (2 when straight; none without bending).
-    let smallest = match &frames {
-        Some(frames) if terms.bending => Some(smallest_binormal_denominator(
-            frames,
-            &strand.rest.rod.rest_length,
-        )),
-        _ => None,
-    };
+    // `frames` are those of the shape the step starts from: they set the substep count and
+    // serve the first substep's forces. The sharpest fold's `1 + cos φ` (2 when straight;
+    // none without bending).
+    let smallest = terms
+        .bending
+        .then(|| smallest_binormal_denominator(frames, &strand.rest.rod.rest_length));
     let for_shape = smallest.map_or(fixed, |smallest| {
         substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest)
     });
@@ -339,7 +351,7 @@ fn forces_and_integrate<M: Math, const N: usize>(
         // explicit substeps would whip it and lose it. The implicit step holds it, from now on
         // (one switch per strand, so the cost per step stays bounded by the implicit step's).
         strand.rest.rod.implicit_bending = true;
-        return implicit_step::<M, N>(strand, ctx, clamped, terms, accelerations, report);
+        return implicit_step::<M, N>(strand, ctx, clamped, terms, frames, accelerations, report);
     }
     // Converge mode counts the substeps from the shape the step starts from (with a margin
     // for the fold to tighten within the step); fixed cost takes the count from rest data
@@ -370,11 +382,12 @@ fn forces_and_integrate<M: Math, const N: usize>(
     let substep_projection = inextensibility_between_substeps(ctx, k, h);
     for substep in 0..k {
         if elastic {
-            let frames = frames
-                .take()
-                .unwrap_or_else(|| strand_frames::<M, N>(strand));
+            // The first substep starts where the frames were computed.
+            if substep > 0 {
+                refresh_frames(frames, strand);
+            }
             elastic_forces_with_angles(
-                &frames,
+                frames,
                 &strand.state.theta,
                 &cos_sin,
                 &strand.rest.rod,
@@ -415,6 +428,7 @@ fn implicit_step<M: Math, const N: usize>(
     ctx: &StepContext,
     clamped: &ClampedSegments,
     terms: ElasticTerms,
+    frames: &RodFrames<M, N>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> [[Real; 2]; N] {
@@ -425,10 +439,9 @@ fn implicit_step<M: Math, const N: usize>(
     let n = strand.rest.nodes.min(N);
     let segments = n.saturating_sub(1);
     let cos_sin = material_angles::<M, N>(&strand.state.theta[..segments]);
-    let frames = strand_frames::<M, N>(strand);
     let mut forces = [Vec3::ZERO; N];
     elastic_forces_with_angles(
-        &frames,
+        frames,
         &strand.state.theta,
         &cos_sin,
         &strand.rest.rod,
@@ -437,7 +450,7 @@ fn implicit_step<M: Math, const N: usize>(
         &mut forces,
     );
     let mut system = BendingSystem::<N>::default();
-    system.assemble(&frames, &strand.rest.mass, &strand.rest.rod, h);
+    system.assemble(frames, &strand.rest.mass, &strand.rest.rod, h);
     system.factor();
     let drag = drag(ctx);
     // Right-hand side M (v + h a), with a as in the explicit step.
@@ -456,7 +469,7 @@ fn implicit_step<M: Math, const N: usize>(
         *slot = ((*v + a * h) * *mass).to_array();
     }
     let held_velocity = [0, 1].map(|i| held_node(ctx, rest.position[i], state.position[i]).1);
-    BendingSystem::move_held_nodes(&frames, &rest.rod, h, held_velocity, &mut rhs);
+    BendingSystem::move_held_nodes(frames, &rest.rod, h, held_velocity, &mut rhs);
     system.solve(&mut rhs);
     let nodes = rhs
         .iter()
@@ -635,28 +648,30 @@ fn update_twist<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     clamped: &ClampedSegments,
-    terms: ElasticTerms,
+    frames: &mut RodFrames<M, N>,
     start: &StepStart<M>,
     angles: &[[Real; 2]; N],
     report: &mut StepReport,
 ) {
     report.ran(Stage::Twist);
-    let frames = strand_frames::<M, N>(strand);
+    let terms = elastic_terms(ctx);
+    refresh_frames(frames, strand);
+    let frames = &*frames;
     let segments = strand.rest.nodes.saturating_sub(1).min(N);
     let rest = &strand.rest.rod;
     let theta = &mut strand.state.theta[..segments];
     if let Some(saved) = &start.clamped_frames {
-        saved.transport(&frames, clamped, theta);
+        saved.transport(frames, clamped, theta);
     }
     match ctx.params.rod.twist {
         // The angles' cosines and sines from the start of the step: only clamped segments
         // (skipped by the sweep) have moved since.
         TwistMethod::HairOptimised => {
-            hair_optimised_twist_with_angles(&frames, rest, clamped, terms, theta, angles);
+            hair_optimised_twist_with_angles(frames, rest, clamped, terms, theta, angles);
         }
         TwistMethod::Newton => {
             let outcome = newton_twist(
-                &frames,
+                frames,
                 rest,
                 clamped,
                 terms,

@@ -354,3 +354,25 @@ fn rest_shapes_have_no_energy_and_no_force_under_both_twists() {
         }
     }
 }
+
+#[test]
+fn frames_recomputed_in_place_equal_fresh_ones() {
+    // The rod step reuses one frames buffer per step (`RodFrames::recompute`): every entry
+    // must be what a fresh `compute` gives, whatever the buffer held before.
+    let mut rng = Rng(0x5eed_f4a3);
+    for shape in [Shape::Straight, Shape::Wavy, Shape::Helix] {
+        let points = rest_points(shape);
+        let rest = rest(&points, 1.0);
+        let mut buffer = Frames::empty();
+        for _ in 0..4 {
+            let c = random_config(&points, &rest, &mut rng, 0.3);
+            buffer.recompute(&c.x, c.u0, &rest.rest_length);
+            let fresh = frames(&c.x, c.u0, &rest);
+            assert_eq!(
+                std::format!("{buffer:?}"),
+                std::format!("{fresh:?}"),
+                "{shape:?}"
+            );
+        }
+    }
+}

@@ -212,7 +212,8 @@ fn smallest_binormal_denominator_is_one_plus_cos_of_the_sharpest_turn() {
         points[i + 1] = points[i] + Vec3::new(cos, sin, 0.0) * 0.01;
     }
     let s = Strand::<NODES>::from_polyline(&points[..4], &Material::HUMAN_HAIR).unwrap();
-    let frames = strand_frames::<Libm, NODES>(&s);
+    let mut frames = RodFrames::<Libm, NODES>::empty();
+    refresh_frames(&mut frames, &s);
     let g = smallest_binormal_denominator(&frames, &s.rest.rod.rest_length);
     assert!((g - (1.0 + libm::cosf(1.9))).abs() < 1e-5, "{g}");
 }
