@@ -322,7 +322,9 @@ fn substeps_at_stiffness<const N: usize>(
 /// current shape, [`substeps_within_step`]): the elastic forces of
 /// Kmoch Sec. 7.2 at the current `θ` ([`elastic_forces_with_angles`]), then
 /// [`external_forces_and_integrate`]. Returns `(cos θ^j, sin θ^j)` of the angles it used
-/// (the hair-optimised twist compares against them).
+/// (the hair-optimised twist compares against them). `frames` come in as those of the
+/// centreline the step starts from (with bending or twist on) and are recomputed in place for
+/// each later substep.
 fn forces_and_integrate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -418,7 +420,8 @@ fn forces_and_integrate<M: Math, const N: usize>(
 /// Stages (1) and (2) with bending on, as one linearly implicit step of `dt`
 /// ([`super::implicit`]): the elastic forces of Kmoch Sec. 7.2 at the current `θ`, the
 /// external forces as in [`external_forces_and_integrate`], then
-/// `(M + dt² H̃) v⁺ = M (v + dt a)` and `x⁺ = x + dt v⁺`. Returns `(cos θ^j, sin θ^j)`.
+/// `(M + dt² H̃) v⁺ = M (v + dt a)` and `x⁺ = x + dt v⁺`, all at `frames`, those of the
+/// centreline the step starts from. Returns `(cos θ^j, sin θ^j)`.
 ///
 /// Not inlined: inlined into [`forces_and_integrate`] it made the substep path of human hair
 /// 2.4 % dearer on the Cortex-M4F (QEMU, 128 nodes), 1.2 % with it kept apart.
@@ -642,8 +645,9 @@ fn root_coupling_with_frame<M: Math, const N: usize>(
     state.root_frame = u;
 }
 
-/// Stage (5): the quasistatic twist for the new centreline — the clamped segments' frames by
-/// time-parallel transport, then the free angles by the scene's [`TwistMethod`].
+/// Stage (5): the quasistatic twist for the new centreline — its frames (recomputed in place
+/// in `frames`), the clamped segments' frames by time-parallel transport, then the free angles
+/// by the scene's [`TwistMethod`].
 fn update_twist<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
