@@ -115,19 +115,20 @@ pub fn step<M: Math, const N: usize>(
         ClampedSegments::ROOT_ONLY
     };
     let terms = elastic_terms(ctx);
-    // One frames buffer for the step, recomputed in place as the centreline moves.
-    let mut frames = RodFrames::<M, N>::empty();
+    // One frames buffer for the step, recomputed in place as the centreline moves; none
+    // without bending and twist (nothing to zero: an effect that is off costs nothing).
+    let mut frames: Option<RodFrames<M, N>> = None;
     if terms.bending || terms.twist {
-        refresh_frames(&mut frames, strand);
+        refresh_frames(frames.insert(RodFrames::empty()), strand);
     }
-    let start = StepStart::<M>::capture(strand, &clamped, terms, &frames);
+    let start = StepStart::<M>::capture(strand, &clamped, frames.as_ref());
     // (1) elastic forces [bending, twist] and (2) external forces + symplectic Euler, substepped.
     let angles = forces_and_integrate::<M, N>(
         strand,
         ctx,
         &clamped,
         terms,
-        &mut frames,
+        frames.as_mut(),
         accelerations,
         report,
     );
@@ -136,8 +137,9 @@ pub fn step<M: Math, const N: usize>(
     // (4) Fast manifold projection [inextensibility, collisions, grabs] and velocity update.
     crate::projection::project_constraints::<M, N>(strand, ctx, grabs, strand_index, report);
     // (5) Twist [twist]: the Bishop frame in space for the new centreline, then θ.
-    if ctx.has(Effect::Twist) {
-        update_twist::<M, N>(strand, ctx, &clamped, &mut frames, &start, &angles, report);
+    // (Twist on means frames.)
+    if let (true, Some(frames)) = (ctx.has(Effect::Twist), frames.as_mut()) {
+        update_twist::<M, N>(strand, ctx, &clamped, frames, &start, &angles, report);
     }
 }
 
@@ -157,20 +159,18 @@ struct StepStart<M: Math> {
 }
 
 impl<M: Math> StepStart<M> {
-    /// `frames` are those of the strand's centreline (computed when `terms` has bending or
-    /// twist).
+    /// `frames` are those of the strand's centreline, there when bending or twist is on.
     fn capture<const N: usize>(
         strand: &Strand<N>,
         clamped: &ClampedSegments,
-        terms: ElasticTerms,
-        frames: &RodFrames<M, N>,
+        frames: Option<&RodFrames<M, N>>,
     ) -> Self {
-        if !(terms.bending || terms.twist) {
+        let Some(frames) = frames else {
             return StepStart {
                 root_tangent: None,
                 clamped_frames: None,
             };
-        }
+        };
         let x = &strand.state.position;
         let clamped_frames = clamped
             .others()
@@ -322,33 +322,43 @@ fn substeps_at_stiffness<const N: usize>(
 /// current shape, [`substeps_within_step`]): the elastic forces of
 /// Kmoch Sec. 7.2 at the current `θ` ([`elastic_forces_with_angles`]), then
 /// [`external_forces_and_integrate`]. Returns `(cos θ^j, sin θ^j)` of the angles it used
-/// (the hair-optimised twist compares against them). `frames` come in as those of the
-/// centreline the step starts from (with bending or twist on) and are recomputed in place for
-/// each later substep.
+/// (the hair-optimised twist compares against them). `frames`, there when bending or twist is
+/// on, come in as those of the centreline the step starts from and are recomputed in place
+/// for each later substep.
 fn forces_and_integrate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     clamped: &ClampedSegments,
     terms: ElasticTerms,
-    frames: &mut RodFrames<M, N>,
+    mut frames: Option<&mut RodFrames<M, N>>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> [[Real; 2]; N] {
-    let elastic = terms.bending || terms.twist;
     let fixed = substeps(&strand.rest.rod, ctx.dt, terms.bending);
-    if terms.bending && (fixed >= IMPLICIT_FROM || strand.rest.rod.implicit_bending) {
-        return implicit_step::<M, N>(strand, ctx, clamped, terms, frames, accelerations, report);
+    // (Bending on means frames.)
+    let bending_frames = frames.as_deref().filter(|_| terms.bending);
+    if let Some(frames) = bending_frames {
+        if fixed >= IMPLICIT_FROM || strand.rest.rod.implicit_bending {
+            return implicit_step::<M, N>(
+                strand,
+                ctx,
+                clamped,
+                terms,
+                frames,
+                accelerations,
+                report,
+            );
+        }
     }
     // `frames` are those of the shape the step starts from: they set the substep count and
     // serve the first substep's forces. The sharpest fold's `1 + cos φ` (2 when straight;
     // none without bending).
-    let smallest = terms
-        .bending
-        .then(|| smallest_binormal_denominator(frames, &strand.rest.rod.rest_length));
+    let smallest = bending_frames
+        .map(|frames| smallest_binormal_denominator(frames, &strand.rest.rod.rest_length));
     let for_shape = smallest.map_or(fixed, |smallest| {
         substeps_for_shape(&strand.rest.rod, ctx.dt, true, smallest)
     });
-    if terms.bending && for_shape >= IMPLICIT_FROM {
+    if let (Some(frames), true) = (bending_frames, for_shape >= IMPLICIT_FROM) {
         // A fold sharper than substeps can hold (≥ 137° for human hair at 1 cm and 1 ms):
         // explicit substeps would whip it and lose it. The implicit step holds it, from now on
         // (one switch per strand, so the cost per step stays bounded by the implicit step's).
@@ -368,7 +378,7 @@ fn forces_and_integrate<M: Math, const N: usize>(
     let mut forces = [Vec3::ZERO; N];
     let segments = strand.rest.nodes.saturating_sub(1).min(N);
     // θ is held over the substeps: its sines and cosines are computed once.
-    let cos_sin = if elastic {
+    let cos_sin = if frames.is_some() {
         report.ran(Stage::ElasticForces);
         material_angles::<M, N>(&strand.state.theta[..segments])
     } else {
@@ -383,7 +393,7 @@ fn forces_and_integrate<M: Math, const N: usize>(
     let mut displacement = [Vec3::ZERO; N];
     let substep_projection = inextensibility_between_substeps(ctx, k, h);
     for substep in 0..k {
-        if elastic {
+        if let Some(frames) = frames.as_deref_mut() {
             // The first substep starts where the frames were computed.
             if substep > 0 {
                 refresh_frames(frames, strand);
