@@ -3,7 +3,7 @@
 profiling build (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape`, see `src/latency.rs`) and counts the
 instructions executed between the firmware's `step_begins` and `step_ends` markers, per
 function of the core (the innermost one, inlined or not) and per source line, and the
-dynamic share of VDIV/VSQRT and VFMA (against the static share `latency.py` assumes).
+dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or chained (against the static share `latency.py` assumes).
 
     cd firmware && HAIRSIM_PROFILE=dftl_noshape cargo build --release
     qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic -icount shift=0 \\
@@ -17,6 +17,9 @@ import collections
 import re
 import subprocess
 import sys
+
+# The Cortex-M4F's 3-cycle multiply-accumulates (`latency.py`'s model).
+MULTIPLY_ACCUMULATE = ("vfma", "vfms", "vfnma", "vfnms", "vmla", "vmls", "vnmla", "vnmls")
 
 
 def markers(elf):
@@ -69,7 +72,7 @@ def main():
             per_address[address] += n
             if mnemonic.startswith(("vdiv", "vsqrt")):
                 ops["divsqrt"] += n
-            elif mnemonic.startswith(("vfma", "vfms", "vfnma", "vfnms")):
+            elif mnemonic.startswith(MULTIPLY_ACCUMULATE):
                 ops["fma"] += n
     total = sum(per_address.values())
     if not total or not steps:
@@ -89,7 +92,7 @@ def main():
         by_line["/".join(where.split("/")[-2:])] += per_address[address]
     share = ops["divsqrt"] / total
     print(f"{steps} steps, {total / steps:.0f} instructions per step; executed VDIV/VSQRT "
-          f"{100 * share:.2f} %, VFMA {100 * ops['fma'] / total:.2f} % -> "
+          f"{100 * share:.2f} %, multiply-accumulate {100 * ops['fma'] / total:.2f} % -> "
           f"{1 + 13 * share + 2 * ops['fma'] / total:.3f} cycles per instruction")
     for title, counter in (("function", by_function), ("source line", by_line)):
         print(f"\n| {title} | instructions per step | share |\n|---|---:|---:|")

@@ -991,6 +991,7 @@ fn an_injected_nan_rolls_the_strand_back_and_the_report_names_it() {
             .iter()
             .map(|s| s.positions().to_vec())
             .collect();
+        let before_state = world.strands()[1].state.clone();
         // A NaN acceleration on strand 1, node 7 (node i of strand s at s·N + i).
         let mut accelerations = vec![Vec3::ZERO; 3 * N];
         accelerations[N + 7] = Vec3::new(f32::NAN, 0.0, 0.0);
@@ -1010,6 +1011,13 @@ fn an_injected_nan_rolls_the_strand_back_and_the_report_names_it() {
         assert!(strand.state.velocity[..strand.nodes()]
             .iter()
             .all(|v| *v == Vec3::ZERO));
+        // The rest of the state too (DFTL keeps only the positions it writes: its twist and
+        // root frame must be untouched).
+        assert_eq!(strand.state.theta, before_state.theta, "{solver:?}");
+        assert_eq!(
+            strand.state.root_frame, before_state.root_frame,
+            "{solver:?}"
+        );
         // The other strands stepped on, and the state hash is of finite state.
         assert_ne!(world.strands()[0].positions(), &before[0][..]);
         assert!(world.strands().iter().all(|s| s.is_finite()));

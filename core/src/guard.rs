@@ -24,18 +24,25 @@ pub fn check<const N: usize>(
     index: u32,
     report: &mut StepReport,
 ) -> bool {
-    let good = strand.is_finite() && (!inextensible || within_reach(strand));
-    restore_unless(good, strand, last_good, index, report)
+    report.ran(Stage::Guard);
+    if strand.is_finite() && (!inextensible || within_reach(strand)) {
+        return false;
+    }
+    strand.state.clone_from(last_good);
+    stop_and_report(strand, index, report);
+    true
 }
 
-/// The guard with its verdict already known: a solver that watched every value it wrote (the
-/// DFTL step, [`crate::dftl::velocity::not_finite`]) says whether the strand is `good`, and a
-/// strand that is not goes back to `last_good` as in [`check`]. Returns whether it rolled
+/// The guard with its verdict already known, for a solver that watched every value it wrote
+/// (the DFTL step, [`crate::dftl::velocity::not_finite`]) and writes positions and velocities
+/// only (no twist, no root frame): a strand that is not `good` gets `last_good`, its positions
+/// at the start of the step, back — the last good state, since a roll-back zeroes the
+/// velocities anyway — and the report names it, as in [`check`]. Returns whether it rolled
 /// back.
-pub fn restore_unless<const N: usize>(
+pub fn restore_positions_unless<const N: usize>(
     good: bool,
     strand: &mut Strand<N>,
-    last_good: &StrandState<N>,
+    last_good: &[Vec3; N],
     index: u32,
     report: &mut StepReport,
 ) -> bool {
@@ -43,13 +50,18 @@ pub fn restore_unless<const N: usize>(
     if good {
         return false;
     }
-    strand.state.clone_from(last_good);
+    strand.state.position = *last_good;
+    stop_and_report(strand, index, report);
+    true
+}
+
+/// The rest of a roll-back: the restored strand starts from rest, and the report names it.
+fn stop_and_report<const N: usize>(strand: &mut Strand<N>, index: u32, report: &mut StepReport) {
     let n = strand.rest.nodes;
-    for v in &mut strand.state.velocity[..n] {
+    for v in strand.state.velocity.iter_mut().take(n) {
         *v = Vec3::ZERO;
     }
     report.roll_back(index);
-    true
 }
 
 /// Whether every node lies within [`REACH_FACTOR`] times its rest arc length of the root

@@ -38,39 +38,37 @@ pub fn step_strands<M: Math, const N: usize>(
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
+    // What a DFTL step derives from the context (the head's rotation matrix among it) is the
+    // same for every strand: once per block.
+    let dftl_setup = match ctx.params.solver {
+        Solver::Rod => None,
+        Solver::Dftl => Some(crate::dftl::Setup::new(ctx)),
+    };
     for (k, strand) in strands.iter_mut().enumerate() {
         let index = first_strand + k as u32;
         let strand_accelerations = accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
-        // 1. Keep the last good state (quarantine).
+        // 1. Keep the last good state (quarantine), 2. the solver's own stage list (Kmoch
+        // Alg. 1 or Sánchez-Banderas Alg. 1), then 3. the guard: nothing non-finite leaves
+        // the step.
         report.ran(Stage::Snapshot);
+        if let Some(setup) = &dftl_setup {
+            // DFTL writes positions and velocities only, and a roll-back zeroes the
+            // velocities: the positions are the last good state it needs to keep (less than
+            // half the state's bytes). It keeps every segment at length by construction, and
+            // watches what it writes: no second pass over the strand.
+            let last_good = strand.state.position;
+            let good = crate::dftl::step::<M, N>(strand, setup, ctx, strand_accelerations, report);
+            crate::guard::restore_positions_unless(good, strand, &last_good, index, report);
+            continue;
+        }
         let last_good = strand.state.clone();
-        // 2. The solver's own stage list (Kmoch Alg. 1 or Sánchez-Banderas Alg. 1), then
-        // 3. the guard: nothing non-finite leaves the step.
-        let rolled_back = match ctx.params.solver {
-            Solver::Rod => {
-                crate::rod::step::step::<M, N>(
-                    strand,
-                    ctx,
-                    grabs,
-                    index,
-                    strand_accelerations,
-                    report,
-                );
-                // The rod's projection can be outrun by a configuration past its stability
-                // limit, so the rod also checks reach.
-                let inextensible = ctx.has(crate::effects::Effect::Inextensibility);
-                crate::guard::check(strand, &last_good, inextensible, index, report)
-            }
-            Solver::Dftl => {
-                // DFTL keeps every segment at length by construction, and watches what it
-                // writes: no second pass over the strand.
-                let good = crate::dftl::step::<M, N>(strand, ctx, strand_accelerations, report);
-                crate::guard::restore_unless(good, strand, &last_good, index, report)
-            }
-        };
+        crate::rod::step::step::<M, N>(strand, ctx, grabs, index, strand_accelerations, report);
+        // The rod's projection can be outrun by a configuration past its stability limit, so
+        // the rod also checks reach.
+        let inextensible = ctx.has(crate::effects::Effect::Inextensibility);
         // 4. A rod strand the explicit bending substeps lost takes the implicit step from now
         // on (`RodRest::implicit_bending`).
-        if rolled_back && ctx.params.solver == Solver::Rod {
+        if crate::guard::check(strand, &last_good, inextensible, index, report) {
             strand.rest.rod.implicit_bending = true;
         }
     }

@@ -25,7 +25,7 @@ use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
 use super::lane::{Lane, Wide, WideMask, Q, V3};
-use super::{advance, velocity, Chain, Measures, NodeInput, Setup, Tally};
+use super::{advance, velocity, Chain, ColliderPush, Measures, NodeInput, Setup, Tally};
 use crate::collide::MAX_COLLIDERS;
 
 /// Lanes per block the harness should use on x86-64: measured fastest — on the SSE2 baseline
@@ -90,6 +90,9 @@ pub struct DftlBlock<const W: usize, const N: usize> {
     pub rest: [RestLanes<W>; N],
     /// Shape rest data per node.
     pub shape: [ShapeLanes<W>; N],
+    /// `m_k` per node: read only where a collider pushes a node, so kept out of the rest
+    /// data every node reads.
+    pub mass: [Lanes<W>; N],
 }
 
 impl<const W: usize, const N: usize> Default for DftlBlock<W, N> {
@@ -136,6 +139,7 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
                 local_rest: zero,
                 root_distance: [0.0; W],
             }; N],
+            mass: [[0.0; W]; N],
         }
     }
 
@@ -162,6 +166,7 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
                     0.0
                 };
                 rest.inverse_mass[l] = strand.rest.inverse_mass[k];
+                self.mass[k][l] = strand.rest.mass[k];
                 rest.strain_scale[l] = strand.rest.dftl.strain_scale[k];
                 let shape = &mut self.shape[k];
                 set(&mut shape.rest_position, l, strand.rest.position[k]);
@@ -228,32 +233,10 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
     setup.count_stages(ctx, accelerations.is_some(), lanes, report);
     // The effect switches become constants in each copy of the pass, so a stage that is off
     // is not computed (and the lane loops have no branch to vectorise around).
-    let finite = match (setup.shape, setup.inextensibility, setup.drag) {
-        (false, false, false) => {
-            pass::<M, W, N, false, false, false>(ctx, &setup, block, accelerations, report)
-        }
-        (false, false, true) => {
-            pass::<M, W, N, false, false, true>(ctx, &setup, block, accelerations, report)
-        }
-        (false, true, false) => {
-            pass::<M, W, N, false, true, false>(ctx, &setup, block, accelerations, report)
-        }
-        (false, true, true) => {
-            pass::<M, W, N, false, true, true>(ctx, &setup, block, accelerations, report)
-        }
-        (true, false, false) => {
-            pass::<M, W, N, true, false, false>(ctx, &setup, block, accelerations, report)
-        }
-        (true, false, true) => {
-            pass::<M, W, N, true, false, true>(ctx, &setup, block, accelerations, report)
-        }
-        (true, true, false) => {
-            pass::<M, W, N, true, true, false>(ctx, &setup, block, accelerations, report)
-        }
-        (true, true, true) => {
-            pass::<M, W, N, true, true, true>(ctx, &setup, block, accelerations, report)
-        }
-    };
+    let finite = with_effect_switches!(
+        setup,
+        pass::<M, W, N>(ctx, &setup, block, accelerations, report)
+    );
     // Guard (as `guard::check`): a lane that turned non-finite gets its last good state back
     // with zero velocity, and the report names it.
     report.stage_runs[Stage::Guard as usize] += lanes;
@@ -337,6 +320,7 @@ fn pass<
         load(&block.state[1].position),
     );
     let mut measures: Measures<Wide<W>> = Measures::default();
+    let mut collider_push: ColliderPush<Wide<W>> = [V3::zero(); MAX_COLLIDERS];
     let mut previous_contact = Wide::<W>::mask(false);
     // Nodes every lane has: there every lane is active and every selection below is a
     // constant (the same bits as the masked form, without its blends).
@@ -345,6 +329,7 @@ fn pass<
         let carried = Carried {
             chain: &mut chain,
             measures: &mut measures,
+            collider_push: &mut collider_push,
             previous_contact: &mut previous_contact,
             poison: &mut poison,
         };
@@ -373,9 +358,7 @@ fn pass<
     for l in 0..block.strands.min(W) {
         // The pushes are only read with colliders in the scene: no lane gathering without.
         let collider_push = if setup.collisions {
-            measures
-                .collider_push
-                .map(|v| Vec3::new(v.x.0[l], v.y.0[l], v.z.0[l]))
+            collider_push.map(|v| Vec3::new(v.x.0[l], v.y.0[l], v.z.0[l]))
         } else {
             [Vec3::ZERO; MAX_COLLIDERS]
         };
@@ -395,6 +378,7 @@ fn pass<
 struct Carried<'a, const W: usize> {
     chain: &'a mut Chain<Wide<W>>,
     measures: &'a mut Measures<Wide<W>>,
+    collider_push: &'a mut ColliderPush<Wide<W>>,
     previous_contact: &'a mut WideMask<W>,
     poison: &'a mut Wide<W>,
 }
@@ -413,11 +397,12 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: 
     carried: Carried<'_, W>,
 ) {
     let (done, todo) = block.state.split_at_mut(k);
-    let (Some(previous), Some(state), Some(rest), Some(shape)) = (
+    let (Some(previous), Some(state), Some(rest), Some(shape), Some(mass)) = (
         done.last_mut(),
         todo.first_mut(),
         block.rest.get(k),
         block.shape.get(k),
+        block.mass.get(k),
     ) else {
         return;
     };
@@ -452,6 +437,7 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: 
         velocity: load(&state.velocity),
         extra,
         has_extra,
+        mass: Wide(*mass),
         inverse_mass: Wide(rest.inverse_mass),
         rest_position: load(&shape.rest_position),
         local_rest: load(&shape.local_rest),
@@ -468,6 +454,7 @@ fn node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: 
         active,
         *carried.previous_contact,
         carried.measures,
+        carried.collider_push,
     );
     // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
     let next_correction = V3::select(active, next.correction, V3::zero());

@@ -31,6 +31,24 @@
 //! the same per-node functions lane by lane (the compiler vectorises across lanes; nothing is
 //! ever summed across lanes).
 
+/// Calls `pass::<…, SHAPE, INEXTENSIBLE, DRAG>(…)` with the scene's three effect switches
+/// (`setup.shape`, `.inextensibility`, `.drag`) as constants: each copy of a pass then
+/// computes no stage that is off and tests no switch per node. Both paths go through it.
+macro_rules! with_effect_switches {
+    ($setup:expr, $pass:ident::<$($generic:tt),*>($($argument:expr),* $(,)?)) => {
+        match ($setup.shape, $setup.inextensibility, $setup.drag) {
+            (false, false, false) => $pass::<$($generic),*, false, false, false>($($argument),*),
+            (false, false, true) => $pass::<$($generic),*, false, false, true>($($argument),*),
+            (false, true, false) => $pass::<$($generic),*, false, true, false>($($argument),*),
+            (false, true, true) => $pass::<$($generic),*, false, true, true>($($argument),*),
+            (true, false, false) => $pass::<$($generic),*, true, false, false>($($argument),*),
+            (true, false, true) => $pass::<$($generic),*, true, false, true>($($argument),*),
+            (true, true, false) => $pass::<$($generic),*, true, true, false>($($argument),*),
+            (true, true, true) => $pass::<$($generic),*, true, true, true>($($argument),*),
+        }
+    };
+}
+
 pub mod block;
 pub mod collisions;
 pub mod follow_leader;
@@ -153,6 +171,8 @@ pub struct NodeInput<T: Lane> {
     pub extra: V3<T>,
     /// Whether the caller gave an acceleration.
     pub has_extra: T::Mask,
+    /// `m_i` (weighs the collider's push).
+    pub mass: T,
     /// `1/m_i`.
     pub inverse_mass: T,
     /// `x̂_i` (head frame).
@@ -202,9 +222,10 @@ impl<T: Lane> Chain<T> {
     }
 }
 
-/// What a step measures along the way, per lane: strain extremes, penetration, contacts and
-/// the momentum the colliders gave each node. Nothing is ever summed across lanes; sums run
-/// along each strand in node order in both paths, so they are the same bits.
+/// What a step measures along the way, per lane: strain extremes, penetration and contacts
+/// (the momentum the colliders gave is kept apart, in a [`ColliderPush`]: these few running
+/// values can then live in registers through the node loop). Nothing is ever summed across
+/// lanes; sums run along each strand in node order in both paths, so they are the same bits.
 #[derive(Clone, Copy, Debug)]
 pub struct Measures<T> {
     /// Largest strain `(|e|² − l²)/(2 l²)` of a segment without contact (≥ 0).
@@ -219,9 +240,10 @@ pub struct Measures<T> {
     pub penetration: T,
     /// Nodes pushed out.
     pub contacts: T,
-    /// `Σ m Δx^push` per collider (the push-outs, mass weighted).
-    pub collider_push: [V3<T>; MAX_COLLIDERS],
 }
+
+/// `Σ m Δx^push` per collider (the push-outs, mass weighted), per lane.
+pub type ColliderPush<T> = [V3<T>; MAX_COLLIDERS];
 
 impl<T: Lane> Default for Measures<T> {
     fn default() -> Self {
@@ -233,7 +255,6 @@ impl<T: Lane> Default for Measures<T> {
             contact_compressed: zero,
             penetration: zero,
             contacts: zero,
-            collider_push: [V3::zero(); MAX_COLLIDERS],
         }
     }
 }
@@ -255,6 +276,7 @@ pub struct Advanced<T: Lane> {
 /// true) and the block path, so both run the same operations per strand.
 #[inline(always)]
 #[must_use]
+#[allow(clippy::too_many_arguments)]
 pub fn advance<M: Math, T: Lane>(
     setup: &Setup,
     colliders: &[Shape],
@@ -263,6 +285,7 @@ pub fn advance<M: Math, T: Lane>(
     active: T::Mask,
     previous_contact: T::Mask,
     measures: &mut Measures<T>,
+    collider_push: &mut ColliderPush<T>,
 ) -> Advanced<T> {
     let zero = T::splat(0.0);
     // Lines 13–14: external accelerations, prediction (eq. 1).
@@ -305,13 +328,13 @@ pub fn advance<M: Math, T: Lane>(
     // Line 20: collisions (each collider in turn), then what is left inside.
     let mut contact = T::mask(false);
     if setup.collisions {
-        for (shape, push) in colliders.iter().zip(measures.collider_push.iter_mut()) {
+        for (shape, push) in colliders.iter().zip(collider_push.iter_mut()) {
             let (pushed, inside) = collisions::push_out::<M, T>(shape, x);
-            // Where no lane was pushed, `pushed − x` is 0 in every lane: nothing to add (and
-            // no division for the mass).
+            // Where no lane was pushed, `pushed − x` is 0 in every lane: nothing to add. (The
+            // mass is rest data: a `1/inverse_mass` here was hoisted out of the branch by the
+            // compiler, a 14-cycle division at every node on the Cortex-M4F.)
             if T::any(inside) {
-                let mass = T::splat(1.0) / node.inverse_mass;
-                *push = *push + V3::select(active, (pushed - x).scale(mass), V3::zero());
+                *push = *push + V3::select(active, (pushed - x).scale(node.mass), V3::zero());
             }
             x = pushed;
             contact = contact | inside;
@@ -325,8 +348,9 @@ pub fn advance<M: Math, T: Lane>(
                 let depth = collisions::depth::<M, T>(shape, x);
                 measures.penetration = measures.penetration.max_where(pushed, depth);
             }
+            // (Where no lane was pushed this adds 0 to every lane: skipped.)
+            measures.contacts = measures.contacts + T::select(pushed, T::splat(1.0), zero);
         }
-        measures.contacts = measures.contacts + T::select(pushed, T::splat(1.0), zero);
     }
     // The segment's strain, no square root: `(|e|² − l²)/(2l²) = δ + δ²/2` for the relative
     // stretch δ (turned into δ once per strand, [`Tally::from_measures`]).
@@ -336,11 +360,19 @@ pub fn advance<M: Math, T: Lane>(
     if setup.collisions {
         let touched = contact | previous_contact;
         let free = active & !touched;
-        let pushed = active & touched;
-        measures.stretched = measures.stretched.max_where(free, strain);
-        measures.compressed = measures.compressed.max_where(free, -strain);
-        measures.contact_stretched = measures.contact_stretched.max_where(pushed, strain);
-        measures.contact_compressed = measures.contact_compressed.max_where(pushed, -strain);
+        if T::all(free) {
+            // The common case, every lane free: the masked form below selects `strain`
+            // for the free extremes and adds a 0 to the (non-negative) contact ones, which
+            // leaves them as they are — the same bits, without the selects.
+            measures.stretched = measures.stretched.max(strain);
+            measures.compressed = measures.compressed.max(-strain);
+        } else {
+            let pushed = active & touched;
+            measures.stretched = measures.stretched.max_where(free, strain);
+            measures.compressed = measures.compressed.max_where(free, -strain);
+            measures.contact_stretched = measures.contact_stretched.max_where(pushed, strain);
+            measures.contact_compressed = measures.contact_compressed.max_where(pushed, -strain);
+        }
     } else {
         // No collider, no contact: the contact extremes stay 0 in both forms.
         measures.stretched = measures.stretched.max_where(active, strain);
@@ -426,14 +458,14 @@ impl Tally {
     /// One strand's measures as the report gives them (a block builds its lanes' tallies
     /// from [`Measures::stretches`] of all lanes at once).
     #[must_use]
-    pub fn from_measures<M: Math>(m: &Measures<Real>) -> Self {
+    pub fn from_measures<M: Math>(m: &Measures<Real>, collider_push: &ColliderPush<Real>) -> Self {
         let (stretch, contact_stretch) = m.stretches::<M>();
         Tally {
             stretch,
             contact_stretch,
             penetration: m.penetration,
             contacts: m.contacts as u32,
-            collider_push: m.collider_push.map(Vec3::from),
+            collider_push: collider_push.map(Vec3::from),
         }
     }
 
@@ -455,17 +487,18 @@ impl Tally {
     }
 }
 
-/// Steps one strand by `ctx.dt` (SB15 Algorithm 1, local dynamics). `accelerations` (if any)
-/// are the caller's per-node accelerations for this strand, indexed by node. Never panics;
+/// Steps one strand by `ctx.dt` (SB15 Algorithm 1, local dynamics), `setup` being
+/// [`Setup::new`] of `ctx` (built once for all strands). `accelerations` (if any) are the
+/// caller's per-node accelerations for this strand, indexed by node. Never panics;
 /// returns whether every value it wrote is finite ([`velocity::not_finite`]), and the
 /// caller's guard rolls back a strand where it is not.
 pub fn step<M: Math, const N: usize>(
     strand: &mut Strand<N>,
+    setup: &Setup,
     ctx: &StepContext,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> bool {
-    let setup = Setup::new(ctx);
     // Line 12's root: nodes 0 and 1 follow the head, exactly as in the rod solver.
     crate::rod::step::root_coupling(strand, ctx, report);
     setup.count_stages(ctx, accelerations.is_some(), 1, report);
@@ -474,10 +507,47 @@ pub fn step<M: Math, const N: usize>(
     for v in strand.state.velocity.iter().take(2) {
         poison += velocity::not_finite(V3::from(*v));
     }
-    let n = strand.rest.nodes.min(N);
-    if n < 3 {
+    if strand.rest.nodes.min(N) < 3 {
         return poison == 0.0;
     }
+    let colliders = ctx.colliders();
+    let mut collider_push = [V3::zero(); MAX_COLLIDERS];
+    let (measures, pass_poison) = with_effect_switches!(
+        setup,
+        strand_pass::<M, N>(setup, strand, colliders, accelerations, &mut collider_push)
+    );
+    Tally::from_measures::<M>(&measures, &collider_push).report(
+        report,
+        colliders.len(),
+        setup.inv_dt,
+    );
+    poison + pass_poison == 0.0
+}
+
+/// Nodes `2 …` of one strand with the effect switches fixed: lines 13–21 for node `i`, then
+/// lines 24–26 for node `i − 1`. Returns what it measured and the sum of
+/// [`velocity::not_finite`] over the velocities it wrote.
+#[inline(never)]
+fn strand_pass<
+    M: Math,
+    const N: usize,
+    const SHAPE: bool,
+    const INEXTENSIBLE: bool,
+    const DRAG: bool,
+>(
+    setup: &Setup,
+    strand: &mut Strand<N>,
+    colliders: &[Shape],
+    accelerations: Option<&[Vec3]>,
+    collider_push: &mut ColliderPush<Real>,
+) -> (Measures<Real>, Real) {
+    let setup = Setup {
+        shape: SHAPE,
+        inextensibility: INEXTENSIBLE,
+        drag: DRAG,
+        ..*setup
+    };
+    let n = strand.rest.nodes.min(N);
     let rest = &strand.rest;
     let state = &mut strand.state;
     let mut chain = Chain::start(
@@ -487,6 +557,7 @@ pub fn step<M: Math, const N: usize>(
         state.position[1].into(),
     );
     let mut measures = Measures::default();
+    let mut poison: Real = 0.0;
     let mut previous_contact = false;
     for i in 2..n {
         let extra = accelerations.and_then(|a| a.get(i)).copied();
@@ -495,6 +566,7 @@ pub fn step<M: Math, const N: usize>(
             velocity: state.velocity[i].into(),
             extra: extra.unwrap_or(Vec3::ZERO).into(),
             has_extra: extra.is_some(),
+            mass: rest.mass[i],
             inverse_mass: rest.inverse_mass[i],
             rest_position: rest.position[i].into(),
             local_rest: rest.dftl.local_rest[i].into(),
@@ -505,12 +577,13 @@ pub fn step<M: Math, const N: usize>(
         // Lines 13–21: predict, shape, follow the leader, collisions, frame.
         let next = advance::<M, Real>(
             &setup,
-            ctx.colliders(),
+            colliders,
             &node,
             &chain,
             true,
             previous_contact,
             &mut measures,
+            collider_push,
         );
         // Lines 24–26 for node i − 1, now that node i's correction is known.
         if i > 2 {
@@ -537,8 +610,7 @@ pub fn step<M: Math, const N: usize>(
     state.position[n - 1] = x_new.into();
     state.velocity[n - 1] = v_new.into();
     poison += velocity::not_finite(v_new);
-    Tally::from_measures::<M>(&measures).report(report, ctx.colliders().len(), setup.inv_dt);
-    poison == 0.0
+    (measures, poison)
 }
 
 #[cfg(test)]
@@ -620,6 +692,7 @@ mod tests {
                 velocity: V3::zero(),
                 extra: V3::zero(),
                 has_extra: false,
+                mass: s.rest.mass[i],
                 inverse_mass: s.rest.inverse_mass[i],
                 rest_position: s.rest.position[i].into(),
                 local_rest: s.rest.dftl.local_rest[i].into(),
@@ -628,8 +701,18 @@ mod tests {
                 strain_scale: s.rest.dftl.strain_scale[i],
             };
             let mut measures = Measures::default();
-            chain =
-                advance::<Libm, Real>(&setup, &[], &node, &chain, true, false, &mut measures).chain;
+            let mut push = [V3::zero(); MAX_COLLIDERS];
+            chain = advance::<Libm, Real>(
+                &setup,
+                &[],
+                &node,
+                &chain,
+                true,
+                false,
+                &mut measures,
+                &mut push,
+            )
+            .chain;
             assert!(measures.stretched < 1e-6 && measures.compressed < 1e-6);
         }
         assert_eq!(s.rest.dftl.root_distance[11], 1.0);
