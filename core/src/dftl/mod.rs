@@ -720,15 +720,29 @@ mod tests {
 
     #[test]
     fn block_gives_the_bits_of_the_per_strand_path() {
+        // Every specialisation of both passes (`with_effect_switches!`): shape,
+        // inextensibility and drag each on and off, with gravity, wind and a collider.
+        for switches in 0..8u32 {
+            let mut effects = std::vec![Effect::Gravity, Effect::Collisions, Effect::Wind];
+            for (bit, effect) in [Effect::Shape, Effect::Inextensibility, Effect::Drag]
+                .into_iter()
+                .enumerate()
+            {
+                if switches & (1 << bit) != 0 {
+                    effects.push(effect);
+                }
+            }
+            // Both colliders reached in every configuration: the contact branches ran too.
+            let contacts = block_matches_per_strand(&effects);
+            assert!(contacts > 0, "{effects:?}");
+        }
+    }
+
+    /// Steps both paths 300 steps and checks they agree (state, report); returns the
+    /// contacts seen.
+    fn block_matches_per_strand(effects: &[Effect]) -> u32 {
         let p = Params {
-            effects: Effects::from_slice(&[
-                Effect::Gravity,
-                Effect::Drag,
-                Effect::Shape,
-                Effect::Inextensibility,
-                Effect::Collisions,
-                Effect::Wind,
-            ]),
+            effects: Effects::from_slice(effects),
             drag: 2.0e-7,
             ..params(&[])
         };
@@ -737,6 +751,16 @@ mod tests {
             shape: Shape::Sphere {
                 centre: Vec3::ZERO,
                 radius: 0.05,
+            },
+            attached_to_head: true,
+        })
+        .unwrap();
+        // A capsule across the strands 5 cm above the roots: they touch it with shape on too.
+        w.add_collider(Collider {
+            shape: Shape::Capsule {
+                a: Vec3::new(-0.02, 0.1, 0.0),
+                b: Vec3::new(0.02, 0.1, 0.0),
+                radius: 0.005,
             },
             attached_to_head: true,
         })
@@ -752,7 +776,8 @@ mod tests {
         ];
         let coefficients = p.dftl.at_step(p.dt);
         let mut previous = Pose::IDENTITY;
-        for k in 0..500u32 {
+        let mut contacts = 0;
+        for k in 0..300u32 {
             let t = (k + 1) as Real * p.dt;
             let head = Shake::TEN_RAD_PER_S.pose_at::<Libm>(t);
             let report = w.step(&StepInput {
@@ -770,18 +795,36 @@ mod tests {
             let mut block_report = StepReport::default();
             step_blocks::<Libm, 4, 16>(&ctx, &mut blocks, 0, None, &mut block_report);
             previous = head;
-            assert_eq!(report.stage_runs, block_report.stage_runs);
-            assert_eq!(
-                report.max_stretch.to_bits(),
-                block_report.max_stretch.to_bits()
-            );
-            assert_eq!(report.contacts, block_report.contacts);
+            assert_eq!(report.stage_runs, block_report.stage_runs, "{effects:?}");
+            let bits = |r: &StepReport| {
+                let [a, b] = [r.collider_forces[0], r.collider_forces[1]];
+                [
+                    r.max_stretch,
+                    r.max_contact_stretch,
+                    r.max_penetration,
+                    a.x,
+                    a.y,
+                    a.z,
+                    b.x,
+                    b.y,
+                    b.z,
+                ]
+                .map(Real::to_bits)
+            };
+            assert_eq!(bits(&report), bits(&block_report), "{effects:?} step {k}");
+            assert_eq!(report.contacts, block_report.contacts, "{effects:?}");
+            contacts += report.contacts;
         }
         let mut strands: std::vec::Vec<Strand<16>> = w.strands().to_vec();
         blocks[0].store(&mut strands[..4]);
         blocks[1].store(&mut strands[4..]);
-        assert_eq!(crate::hash::state_hash(&strands), w.state_hash());
+        assert_eq!(
+            crate::hash::state_hash(&strands),
+            w.state_hash(),
+            "{effects:?}"
+        );
         assert!(w.strands()[4].state.position[10].y != points_y(&wavy(14, 4.0)));
+        contacts
     }
 
     fn points_y(p: &[Vec3]) -> Real {
