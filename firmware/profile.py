@@ -3,7 +3,8 @@
 profiling build (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape`, see `src/latency.rs`) and counts the
 instructions executed between the firmware's `step_begins` and `step_ends` markers, per
 function of the core (the innermost one, inlined or not) and per source line, and the
-dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or chained (against the static share `latency.py` assumes).
+dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or chained (against the
+static share `latency.py` assumes).
 
     cd firmware && HAIRSIM_PROFILE=dftl_noshape cargo build --release
     qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic -icount shift=0 \\
