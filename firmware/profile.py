@@ -4,7 +4,9 @@ profiling build (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape`, see `src/latency.rs`) 
 instructions executed between the firmware's `step_begins` and `step_ends` markers, per
 function of the core (the innermost one, inlined or not) and per source line, and the
 dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or chained (against the
-static share `latency.py` assumes).
+static share `latency.py` assumes), and the executed mix by kind of instruction: floating-point
+arithmetic (flops, counting a multiply-accumulate as two), loads and stores, moves, integer work
+and branches (`docs/study/floors.md` sets the floating-point part against the models' floors).
 
     cd firmware && HAIRSIM_PROFILE=dftl_noshape cargo build --release
     qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic -icount shift=0 \\
@@ -21,6 +23,28 @@ import sys
 
 # The Cortex-M4F's 3-cycle multiply-accumulates (`latency.py`'s model).
 MULTIPLY_ACCUMULATE = ("vfma", "vfms", "vfnma", "vfnms", "vmla", "vmls", "vnmla", "vnmls")
+
+# Kinds of instruction, first match wins (by mnemonic prefix); the rest is integer work.
+KINDS = (
+    ("VDIV/VSQRT", ("vdiv", "vsqrt")),
+    ("multiply-accumulate", MULTIPLY_ACCUMULATE),
+    ("other FP arithmetic", ("vadd", "vsub", "vmul", "vnmul", "vneg", "vabs")),
+    ("FP compare", ("vcmp", "vmrs")),
+    ("FP load", ("vldr", "vldm", "vpop")),
+    ("FP store", ("vstr", "vstm", "vpush")),
+    ("FP move/convert/select", ("vmov", "vsel", "vcvt")),
+    ("load", ("ldr", "ldm", "pop")),
+    ("store", ("str", "stm", "push")),
+    ("branch/IT", ("b", "cb", "it")),
+)
+
+
+def kind(mnemonic):
+    """The instruction's kind in `KINDS`, or integer work."""
+    for name, prefixes in KINDS:
+        if mnemonic.startswith(prefixes):
+            return name
+    return "integer"
 
 
 def markers(elf):
@@ -67,14 +91,11 @@ def main():
     marks = markers(elf)
     blocks, runs = read_trace(trace, marks)
     steps = runs.get(min(a for a, begins in marks.items() if begins), 0)
-    per_address, ops = collections.Counter(), collections.Counter()
+    per_address, kinds = collections.Counter(), collections.Counter()
     for pc, n in runs.items():
         for address, mnemonic in blocks.get(pc, []):
             per_address[address] += n
-            if mnemonic.startswith(("vdiv", "vsqrt")):
-                ops["divsqrt"] += n
-            elif mnemonic.startswith(MULTIPLY_ACCUMULATE):
-                ops["fma"] += n
+            kinds[kind(mnemonic)] += n
     total = sum(per_address.values())
     if not total or not steps:
         sys.exit("no step in the trace")
@@ -91,10 +112,17 @@ def main():
         function, where = core[0] if core else pairs[0]
         by_function[function] += per_address[address]
         by_line["/".join(where.split("/")[-2:])] += per_address[address]
-    share = ops["divsqrt"] / total
+    slow, mac = kinds["VDIV/VSQRT"], kinds["multiply-accumulate"]
     print(f"{steps} steps, {total / steps:.0f} instructions per step; executed VDIV/VSQRT "
-          f"{100 * share:.2f} %, multiply-accumulate {100 * ops['fma'] / total:.2f} % -> "
-          f"{1 + 13 * share + 2 * ops['fma'] / total:.3f} cycles per instruction")
+          f"{100 * slow / total:.2f} %, multiply-accumulate {100 * mac / total:.2f} % -> "
+          f"{1 + (13 * slow + 2 * mac) / total:.3f} cycles per instruction")
+    flops = kinds["other FP arithmetic"] + 2 * mac + slow
+    fp_cycles = kinds["other FP arithmetic"] + 3 * mac + 14 * slow
+    print(f"floating-point arithmetic per step: {flops / steps:.0f} flops (a multiply-accumulate "
+          f"is two), {fp_cycles / steps:.0f} cycles of it in the model")
+    print("\n| kind | instructions per step | share |\n|---|---:|---:|")
+    for name, n in kinds.most_common():
+        print(f"| {name} | {n / steps:.0f} | {100 * n / total:.1f} % |")
     for title, counter in (("function", by_function), ("source line", by_line)):
         print(f"\n| {title} | instructions per step | share |\n|---|---:|---:|")
         for name, n in counter.most_common(rows):
