@@ -44,9 +44,14 @@ pub trait Scalar:
     fn to_f32(self) -> f32;
     /// `|x|`.
     fn abs(self) -> Self;
+    /// 1/π.
+    const FRAC_1_PI: Self;
     /// Largest integer `≤ x` (exact, the same bits on every target) for `|x| < 2³¹`; the
     /// kernels only floor angle ratios. Plain conversions, no libm call.
     fn floor(self) -> Self;
+    /// [`Scalar::floor`] and whether that integer is odd, read from the integer itself (a
+    /// second floor of `k/2` would sit on the hair-optimised twist's sequential chain).
+    fn floor_and_parity(self) -> (Self, bool);
     /// Whether the value is neither infinite nor NaN.
     fn is_finite(self) -> bool;
 }
@@ -55,6 +60,7 @@ impl Scalar for f32 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     const PI: Self = core::f32::consts::PI;
+    const FRAC_1_PI: Self = core::f32::consts::FRAC_1_PI;
     #[inline(always)]
     fn of(x: f32) -> Self {
         x
@@ -77,6 +83,16 @@ impl Scalar for f32 {
         }
     }
     #[inline(always)]
+    fn floor_and_parity(self) -> (Self, bool) {
+        let truncated = self as i32;
+        let k = if truncated as f32 > self {
+            truncated.wrapping_sub(1)
+        } else {
+            truncated
+        };
+        (k as f32, k & 1 != 0)
+    }
+    #[inline(always)]
     fn is_finite(self) -> bool {
         f32::is_finite(self)
     }
@@ -86,6 +102,7 @@ impl Scalar for f64 {
     const ZERO: Self = 0.0;
     const ONE: Self = 1.0;
     const PI: Self = core::f64::consts::PI;
+    const FRAC_1_PI: Self = core::f64::consts::FRAC_1_PI;
     #[inline(always)]
     fn of(x: f32) -> Self {
         f64::from(x)
@@ -106,6 +123,16 @@ impl Scalar for f64 {
         } else {
             truncated
         }
+    }
+    #[inline(always)]
+    fn floor_and_parity(self) -> (Self, bool) {
+        let truncated = self as i64;
+        let k = if truncated as f64 > self {
+            truncated.wrapping_sub(1)
+        } else {
+            truncated
+        };
+        (k as f64, k & 1 != 0)
     }
     #[inline(always)]
     fn is_finite(self) -> bool {
@@ -256,6 +283,31 @@ mod tests {
         }
         for x in [-2.0_f32, -1.0, -0.0, 0.0, 0.5, -0.5, 1.0, 3.999_999_8] {
             assert_eq!(Scalar::floor(x), libm::floorf(x), "{x}");
+        }
+    }
+
+    #[test]
+    fn floor_and_parity_agree_with_floor() {
+        let mut x = -1000.0_f32;
+        while x < 1000.0 {
+            let k = libm::floorf(x);
+            let odd = libm::fmodf(k, 2.0) != 0.0;
+            assert_eq!(Scalar::floor_and_parity(x), (k, odd), "{x}");
+            let wide = f64::from(x);
+            assert_eq!(
+                Scalar::floor_and_parity(wide),
+                (libm::floor(wide), odd),
+                "{x}"
+            );
+            x += 0.123_7;
+        }
+        for x in [-3.0_f32, -2.5, -1.0, -0.0, 0.0, 0.5, 1.0, 2.0, 3.999_999_8] {
+            let k = libm::floorf(x);
+            assert_eq!(
+                Scalar::floor_and_parity(x),
+                (k, libm::fmodf(k, 2.0) != 0.0),
+                "{x}"
+            );
         }
     }
 }

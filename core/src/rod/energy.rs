@@ -118,7 +118,10 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         for j in 1..segments {
             let previous = rest.rest_theta[j - 1];
             rest.rest_theta[j] = match binormal_direction(&frames, j) {
-                Some(direction) => nearest_representative::<P>(direction, previous).0,
+                Some(direction) => {
+                    let phi = P::atan2(direction[1], direction[0]);
+                    representative_near(phi, direction, previous).0
+                }
                 None => previous,
             };
             rest.rest_twist[j] = rest.rest_theta[j] - rest.rest_theta[j - 1];
@@ -154,19 +157,21 @@ pub fn rest_root_frame<P: Precision>(root: P::V, next: P::V, rest_length: P::R) 
 }
 
 /// The representative of the direction `(cos φ, sin φ)` (an unoriented line, defined mod π)
-/// closest to `reference`: `θ = φ + kπ`. Returns `θ` and `(cos θ, sin θ)`.
+/// closest to `reference`: `θ = φ + kπ`, with `φ = atan2(sin φ, cos φ)` given. Returns `θ`,
+/// `(cos θ, sin θ)`, and whether `k` is odd (the direction flipped).
+#[inline(always)]
 #[must_use]
-pub fn nearest_representative<P: Precision>(
-    direction: [P::R; 2],
-    reference: P::R,
-) -> (P::R, [P::R; 2]) {
+pub fn representative_near<R: Scalar>(
+    phi: R,
+    direction: [R; 2],
+    reference: R,
+) -> (R, [R; 2], bool) {
     let [c, s] = direction;
-    let phi = P::atan2(s, c);
-    let half = P::R::of(0.5);
-    let k = ((reference - phi) / P::R::PI + half).floor();
-    let odd = k - P::R::of(2.0) * (k * half).floor() > half;
+    // On the twist sweep's sequential chain (`reference` is the neighbour's new angle): a
+    // multiplication by 1/π rather than a division, and the parity from the integer.
+    let (k, odd) = ((reference - phi) * R::FRAC_1_PI + R::of(0.5)).floor_and_parity();
     let cos_sin = if odd { [-c, -s] } else { [c, s] };
-    (phi + k * P::R::PI, cos_sin)
+    (phi + k * R::PI, cos_sin, odd)
 }
 
 /// The frames of a strand's current configuration: segments, tangents, curvature binormals,

@@ -13,7 +13,7 @@
 
 use super::energy::{
     bending_matrix, bending_twist_derivative, elastic_energy, material_angles, material_curvature,
-    nearest_representative, node_twist_energy, twist_stiffness, twist_twist_derivative, RodFrames,
+    node_twist_energy, representative_near, twist_stiffness, twist_twist_derivative, RodFrames,
     RodRest,
 };
 use super::{ClampedSegments, ElasticTerms, MAX_CLAMPED};
@@ -53,6 +53,10 @@ const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
 /// and `j + 1` in the Bishop frame of segment `j` (Kmoch Sec. 6.2), averaged as lines:
 /// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
 /// doubled angle is a complex square, the half angle a square root.
+///
+/// Two divisions: the weights `1/r_k` share one (`Σ z_k/r_k` is kept as a fraction), and the
+/// half angle of `z = X + iY` is `(|z| + X, Y)` (or `(Y, |z| − X)`, the same line, when
+/// `X < 0`), normalised once.
 #[inline(always)]
 #[must_use]
 pub fn binormal_direction<P: Precision, const N: usize>(
@@ -61,14 +65,16 @@ pub fn binormal_direction<P: Precision, const N: usize>(
 ) -> Option<[P::R; 2]> {
     let n = frames.interior();
     let fade = P::R::of(BINORMAL_FADE);
+    // Σ_k z_k / r_k with z_k = (a² − b², 2ab) and r_k = a² + b² + ε², as `sum / scale`.
     let mut sum = [P::R::ZERO; 2];
+    let mut scale = P::R::ONE;
     // (κb·u^j, κb·v^j) = (−p₁, p₀) for node j (frame j = its "next") and node j + 1 ("prev").
     let mut add = |p: [P::R; 2]| {
         let (a, b) = (-p[1], p[0]);
-        let r2 = a * a + b * b;
-        let w = P::R::ONE / (r2 + fade);
-        sum[0] += (a * a - b * b) * w;
-        sum[1] += P::R::of(2.0) * a * b * w;
+        let r = a * a + b * b + fade;
+        sum[0] = sum[0] * r + (a * a - b * b) * scale;
+        sum[1] = sum[1] * r + P::R::of(2.0) * a * b * scale;
+        scale *= r;
     };
     if j >= 1 && j <= n {
         add(frames.bishop_curvature[j][1]);
@@ -76,21 +82,25 @@ pub fn binormal_direction<P: Precision, const N: usize>(
     if j < n {
         add(frames.bishop_curvature[j + 1][0]);
     }
-    let weight2 = sum[0] * sum[0] + sum[1] * sum[1];
+    let inverse_scale = P::R::ONE / scale;
+    let (x, y) = (sum[0] * inverse_scale, sum[1] * inverse_scale);
+    let weight2 = x * x + y * y;
     let min = P::R::of(BINORMAL_MIN_WEIGHT);
     if weight2 <= min * min || !weight2.is_finite() {
         return None;
     }
-    let inv = P::R::ONE / P::sqrt(weight2);
-    let (cos2, sin2) = (sum[0] * inv, sum[1] * inv);
-    let half = P::R::of(0.5);
-    Some(if cos2 >= P::R::ZERO {
-        let c = P::sqrt((P::R::ONE + cos2) * half);
-        [c, sin2 * half / c]
+    let weight = P::sqrt(weight2);
+    let half_angle = if x >= P::R::ZERO {
+        [weight + x, y]
     } else {
-        let s = P::sqrt((P::R::ONE - cos2) * half);
-        [sin2 * half / s, s]
-    })
+        [y, weight - x]
+    };
+    let inverse_length =
+        P::R::ONE / P::sqrt(half_angle[0] * half_angle[0] + half_angle[1] * half_angle[1]);
+    Some([
+        half_angle[0] * inverse_length,
+        half_angle[1] * inverse_length,
+    ])
 }
 
 /// The bending energy of nodes `j`, `j + 1` in frame `j` at `θ` and at `θ ± π`:
@@ -193,16 +203,26 @@ pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
     theta: &mut [P::R],
     current: &[[P::R; 2]],
 ) {
-    let segments = frames.nodes.saturating_sub(1).min(theta.len());
+    let segments = frames.nodes.saturating_sub(1).min(theta.len()).min(N);
     if segments == 0 {
         return;
     }
     let n = frames.interior().min(segments - 1);
+    // Two passes. The first computes everything that does not depend on the angles the sweep
+    // chooses: the binormal directions with their `atan2` and the candidates' bending
+    // energies. With nothing linking one segment to the next, the processor overlaps them.
+    // The second is the sweep root → tip, which only compares (see [`Candidates`]).
+    let mut prepared = [Candidates::<P::R>::default(); N];
+    for (j, slot) in prepared.iter_mut().enumerate().take(segments).skip(1) {
+        if !clamped.contains(j) {
+            *slot = Candidates::of(frames, rest, terms, j, theta[j], current.get(j).copied());
+        }
+    }
     // (cos θ^{j−1}, sin θ^{j−1}), carried down the strand: one sin_cos per strand (and per
     // clamped segment), none per node.
     let (s, c) = P::sin_cos(theta[0]);
     let mut previous = [c, s];
-    for j in 1..segments {
+    for (j, prepared) in prepared.iter().enumerate().take(segments).skip(1) {
         if clamped.contains(j) {
             let (s, c) = P::sin_cos(theta[j]);
             previous = [c, s];
@@ -218,15 +238,8 @@ pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
         let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
         // The current angle first: a candidate must be strictly lower to replace it.
         let kept = theta[j];
-        let kept_cos_sin = match current.get(j) {
-            Some(&cs) => cs,
-            None => {
-                let (s, c) = P::sin_cos(kept);
-                [c, s]
-            }
-        };
-        let mut best = (kept, kept_cos_sin);
-        let mut best_energy = local_bending(frames, rest, terms, j, kept_cos_sin).0 + twist(kept);
+        let mut best = (kept, prepared.kept_cos_sin);
+        let mut best_energy = prepared.kept_bending + twist(kept);
         let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
         let mut consider = |candidate: P::R, cos_sin: [P::R; 2], bending: P::R| {
             let energy = bending + twist(candidate);
@@ -236,9 +249,16 @@ pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
             }
         };
         consider(reference, reference_cos_sin, continued);
-        if let Some(direction) = binormal_direction(frames, j) {
-            let (angle, cos_sin) = nearest_representative::<P>(direction, reference);
-            let (aligned, flipped_bending) = local_bending(frames, rest, terms, j, cos_sin);
+        if let Some(binormal) = prepared.binormal {
+            let (angle, cos_sin, odd) =
+                representative_near(binormal.angle, binormal.direction, reference);
+            // `ω(θ + π) = −ω(θ)`: the flipped representative swaps the two energies (the
+            // same bits: negation is exact and rounding symmetric).
+            let (aligned, flipped_bending) = if odd {
+                (binormal.bending.1, binormal.bending.0)
+            } else {
+                binormal.bending
+            };
             let flipped = [-cos_sin[0], -cos_sin[1]];
             consider(angle, cos_sin, aligned);
             consider(angle + P::R::PI, flipped, flipped_bending);
@@ -246,6 +266,54 @@ pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
         }
         theta[j] = best.0;
         previous = best.1;
+    }
+}
+
+/// What the hair-optimised sweep needs of one segment that does not depend on the angles it
+/// chooses before it: the current angle's cosine, sine and bending energy, and the binormal
+/// direction's angle and bending energies.
+#[derive(Clone, Copy, Debug, Default)]
+struct Candidates<R> {
+    kept_cos_sin: [R; 2],
+    /// Bending energy of nodes `j`, `j + 1` at the current angle.
+    kept_bending: R,
+    binormal: Option<Binormal<R>>,
+}
+
+/// The binormal direction of a segment ([`binormal_direction`]) and what the sweep needs of it.
+#[derive(Clone, Copy, Debug, Default)]
+struct Binormal<R> {
+    /// `(cos φ, sin φ)`.
+    direction: [R; 2],
+    /// `φ = atan2(sin φ, cos φ)`.
+    angle: R,
+    /// Bending energies at `φ` and at `φ ± π`.
+    bending: (R, R),
+}
+
+impl<R: Scalar> Candidates<R> {
+    #[inline(always)]
+    fn of<P: Precision<R = R>, const N: usize>(
+        frames: &RodFrames<P, N>,
+        rest: &RodRest<N, R>,
+        terms: ElasticTerms,
+        j: usize,
+        kept: R,
+        kept_cos_sin: Option<[R; 2]>,
+    ) -> Self {
+        let kept_cos_sin = kept_cos_sin.unwrap_or_else(|| {
+            let (s, c) = P::sin_cos(kept);
+            [c, s]
+        });
+        Candidates {
+            kept_cos_sin,
+            kept_bending: local_bending(frames, rest, terms, j, kept_cos_sin).0,
+            binormal: binormal_direction(frames, j).map(|direction| Binormal {
+                direction,
+                angle: P::atan2(direction[1], direction[0]),
+                bending: local_bending(frames, rest, terms, j, direction),
+            }),
+        }
     }
 }
 
@@ -599,6 +667,63 @@ mod tests {
         let e_hair = elastic_energy(&frames, &hair, &rest, ElasticTerms::ALL);
         let e_newton = elastic_energy(&frames, &newton, &rest, ElasticTerms::ALL);
         (gap, e_hair, e_newton)
+    }
+
+    /// The binormal direction against its definition: `φ = ½ arg Σ_k z_k/r_k` by `atan2`, as
+    /// a line (mod π), on random binormals from rounding size to sharp folds, one or two nodes.
+    #[test]
+    fn binormal_direction_is_half_the_argument_of_the_weighted_squares() {
+        let mut rng = Rng(5);
+        let mut frames = RodFrames::<F64, NODES>::empty();
+        frames.nodes = 4;
+        let (mut checked, mut none) = (0, 0);
+        for trial in 0..20_000 {
+            let magnitude = 10f64.powf(-9.0 + 10.0 * (rng.next() + 0.5));
+            let other = 10f64.powf(-9.0 + 10.0 * (rng.next() + 0.5));
+            frames.bishop_curvature[1][1] = [rng.next() * magnitude, rng.next() * magnitude];
+            frames.bishop_curvature[2][0] = [rng.next() * other, rng.next() * other];
+            frames.bishop_curvature[2][1] = [rng.next() * other, rng.next() * other];
+            // Segment 1 sees nodes 1 and 2 (in its frame); segment 2, the last with n = 2
+            // interior nodes, only node 2.
+            let j = 1 + trial % 2;
+            let mut z = [0.0; 2];
+            let nodes: &[[f64; 2]] = if j == 1 {
+                &[frames.bishop_curvature[1][1], frames.bishop_curvature[2][0]]
+            } else {
+                &[frames.bishop_curvature[2][1]]
+            };
+            for p in nodes {
+                let (a, b) = (-p[1], p[0]);
+                let r = a * a + b * b + f64::from(BINORMAL_FADE);
+                z[0] += (a * a - b * b) / r;
+                z[1] += 2.0 * a * b / r;
+            }
+            let weight = (z[0] * z[0] + z[1] * z[1]).sqrt();
+            let got = binormal_direction(&frames, j);
+            let min = f64::from(BINORMAL_MIN_WEIGHT);
+            if (weight - min).abs() < 1e-9 {
+                continue;
+            }
+            match got {
+                None => {
+                    assert!(weight < min, "{trial}: weight {weight} but no direction");
+                    none += 1;
+                }
+                Some([c, s]) => {
+                    assert!(weight > min, "{trial}: weight {weight} but a direction");
+                    let phi = 0.5 * z[1].atan2(z[0]);
+                    assert!(((c * c + s * s) - 1.0).abs() < 1e-12, "{trial}: not unit");
+                    // The same line: the cross product of the two unit vectors vanishes.
+                    let across = c * phi.sin() - s * phi.cos();
+                    assert!(across.abs() < 1e-9, "{trial}: {c} {s} against φ = {phi}");
+                    checked += 1;
+                }
+            }
+        }
+        assert!(
+            checked > 10_000 && none > 100,
+            "{checked} directions, {none} none"
+        );
     }
 
     #[test]
