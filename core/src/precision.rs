@@ -38,14 +38,14 @@ pub trait Scalar:
     const ONE: Self;
     /// π.
     const PI: Self;
+    /// 1/π.
+    const FRAC_1_PI: Self;
     /// The `f32` value `x` in this precision (exact).
     fn of(x: f32) -> Self;
     /// The value rounded to `f32`.
     fn to_f32(self) -> f32;
     /// `|x|`.
     fn abs(self) -> Self;
-    /// 1/π.
-    const FRAC_1_PI: Self;
     /// Largest integer `≤ x` (exact, the same bits on every target) for `|x| < 2³¹`; the
     /// kernels only floor angle ratios. Plain conversions, no libm call.
     fn floor(self) -> Self;
@@ -86,7 +86,7 @@ impl Scalar for f32 {
     fn floor_and_parity(self) -> (Self, bool) {
         let truncated = self as i32;
         let k = if truncated as f32 > self {
-            truncated.wrapping_sub(1)
+            truncated.saturating_sub(1)
         } else {
             truncated
         };
@@ -128,7 +128,7 @@ impl Scalar for f64 {
     fn floor_and_parity(self) -> (Self, bool) {
         let truncated = self as i64;
         let k = if truncated as f64 > self {
-            truncated.wrapping_sub(1)
+            truncated.saturating_sub(1)
         } else {
             truncated
         };
