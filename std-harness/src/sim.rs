@@ -85,6 +85,17 @@ impl<M: Math> Math for VectorSqrt<M> {
     }
 }
 
+/// How a simulation steps its strands: the bits are the same either way, only the speed
+/// differs (the golden hashes pin both).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Layout {
+    /// Structure-of-arrays blocks of several strands in lanes, where the solver has them.
+    #[default]
+    Blocks,
+    /// One strand at a time.
+    PerStrand,
+}
+
 /// A simulation of strands with capacity `N`, math backend `M`.
 pub struct Sim<const N: usize, M: Math> {
     /// Parameters.
@@ -116,6 +127,15 @@ pub struct Sim<const N: usize, M: Math> {
 impl<const N: usize, M: Math> Sim<N, M> {
     /// Builds the strands of `prepared` at capacity `N`, to be stepped on `threads` threads.
     pub fn new(prepared: &Prepared, threads: usize) -> Result<Self, FieldError> {
+        Self::with_layout(prepared, threads, Layout::Blocks)
+    }
+
+    /// As [`Sim::new`], stepping the strands in `layout`.
+    pub fn with_layout(
+        prepared: &Prepared,
+        threads: usize,
+        layout: Layout,
+    ) -> Result<Self, FieldError> {
         let head = prepared.motion.pose_at::<M>(0.0);
         let mut strands = Vec::with_capacity(prepared.strands.len());
         for (i, spec) in prepared.strands.iter().enumerate() {
@@ -153,13 +173,13 @@ impl<const N: usize, M: Math> Sim<N, M> {
             None => None,
         };
         let block = prepared.block.max(1);
-        let dftl_blocks = match prepared.params.solver {
-            Solver::Dftl => strands
+        let dftl_blocks = match (prepared.params.solver, layout) {
+            (Solver::Dftl, Layout::Blocks) => strands
                 .chunks(block)
                 .flat_map(|b| b.chunks(LANES))
                 .map(DftlBlock::from_strands)
                 .collect(),
-            Solver::Rod => Vec::new(),
+            _ => Vec::new(),
         };
         Ok(Sim {
             params: prepared.params,

@@ -1,0 +1,229 @@
+//! Golden state hashes: every built-in scene, both solvers, both twist methods, stepped per
+//! strand and in blocks, on 1 and 2 threads.
+//!
+//! Bits change only on purpose. A commit that moves one of these hashes updates the table in
+//! the same commit and says why in its message. The layout and the thread count never move a
+//! hash: every layout × thread combination of a row must give the row's one hash, and the
+//! native configuration must also give it through `hairsim run` (the command-line path).
+//!
+//! To print the whole table after an intended change:
+//! `HAIRSIM_GOLDEN_PRINT=1 cargo test -p hairsim-tests --test golden -- --nocapture`.
+
+use hairsim::builtin::{self, BUILTINS};
+use hairsim::run::{capacity_for, run_builtin, RunOptions};
+use hairsim::scene::{Prepared, RodSpec, Scene};
+use hairsim::sim::{scene_inputs, Layout, Sim};
+use hairsim_core::{DefaultMath, Effect, Solver};
+
+/// One pinned configuration: a built-in scene, the solver it runs, the rod's twist method.
+struct Golden {
+    scene: &'static str,
+    solver: &'static str,
+    /// `"hair-optimised"` or `"newton"` for the rod; `"-"` for DFTL.
+    twist: &'static str,
+    steps: u64,
+    hash: u64,
+}
+
+const fn g(
+    scene: &'static str,
+    solver: &'static str,
+    twist: &'static str,
+    steps: u64,
+    hash: u64,
+) -> Golden {
+    Golden {
+        scene,
+        solver,
+        twist,
+        steps,
+        hash,
+    }
+}
+
+/// The table. Scenes of many strands run fewer steps so the whole test stays within a minute.
+#[rustfmt::skip]
+const TABLE: &[Golden] = &[
+    g("firmware", "rod", "hair-optimised", 1000, 0x56b5e11c4c2a19e9),
+    g("firmware", "rod", "newton", 1000, 0x7292a5312d06ced2),
+    g("firmware", "dftl", "-", 1000, 0xf8a419f91c51b4fd),
+    g("firmware-dftl", "dftl", "-", 1000, 0x6a005d9436c71817),
+    g("firmware-dftl", "rod", "hair-optimised", 1000, 0x894648bd38570b8e),
+    g("firmware-dftl", "rod", "newton", 1000, 0x894648bd38570b8e),
+    g("stand-1", "rod", "hair-optimised", 1000, 0x92b497dadca4eca6),
+    g("stand-1", "rod", "newton", 1000, 0x92b497dadca4eca6),
+    g("stand-1", "dftl", "-", 1000, 0x77a85fc4188c6f36),
+    g("stand-2", "rod", "hair-optimised", 1000, 0xeb63e069bcb7a078),
+    g("stand-2", "rod", "newton", 1000, 0xeb63e069bcb7a078),
+    g("stand-2", "dftl", "-", 1000, 0x3e8dc25fe07148ca),
+    g("stand-3", "rod", "hair-optimised", 1000, 0xe2e399001e8bc081),
+    g("stand-3", "rod", "newton", 1000, 0xe2e399001e8bc081),
+    g("stand-3", "dftl", "-", 1000, 0x6d04daedb1ceb925),
+    g("head-1", "rod", "hair-optimised", 300, 0x484ef0f4279eb076),
+    g("head-1", "rod", "newton", 300, 0x66af36a9dfaef532),
+    g("head-1", "dftl", "-", 300, 0xe97e215354dd94a6),
+    g("head-2", "rod", "hair-optimised", 300, 0x44d063f020a2fb96),
+    g("head-2", "rod", "newton", 300, 0x4af1db1a8d0d57e0),
+    g("head-2", "dftl", "-", 300, 0xbb3c3e88e9f27547),
+    g("head-3", "rod", "hair-optimised", 300, 0x359cfbf5f3d15f28),
+    g("head-3", "rod", "newton", 300, 0x2088475dd18a7b90),
+    g("head-3", "dftl", "-", 300, 0xe67cdf7acb4d8202),
+    g("mannequin-a", "dftl", "-", 4, 0x30edd0ecd0fed210),
+    g("mannequin-a", "rod", "hair-optimised", 4, 0xd937417fb747d651),
+    g("mannequin-a", "rod", "newton", 4, 0xd937417fb747d651),
+    g("mannequin-b", "dftl", "-", 100, 0xb8534c00e2310500),
+    g("mannequin-b", "rod", "hair-optimised", 100, 0x47678888b43edd4a),
+    g("mannequin-b", "rod", "newton", 100, 0x47678888b43edd4a),
+    g("haptic", "rod", "hair-optimised", 1000, 0x055d6f7dd0f07bf7),
+    g("haptic", "rod", "newton", 1000, 0x055d6f7dd0f07bf7),
+    g("haptic", "dftl", "-", 1000, 0xbafdc8987aef5b52),
+];
+
+/// The rod's largest time step (`Params::validate`).
+const ROD_DT_MAX: f32 = 0.004;
+
+/// The built-in scene `row.scene`, switched to `row.solver` and `row.twist`. Effects the other
+/// solver cannot simulate are dropped (with the grabs, for DFTL), and a DFTL scene run by the
+/// rod takes the rod's largest time step if its own is larger; nothing else changes.
+fn configured(row: &Golden) -> Scene {
+    let mut scene = (builtin::find(row.scene).expect("a built-in scene").scene)();
+    let solver = match row.solver {
+        "rod" => Solver::Rod,
+        _ => Solver::Dftl,
+    };
+    scene.solver = row.solver.into();
+    scene
+        .effects
+        .retain(|name| Effect::from_name(name).is_some_and(|effect| solver.supports(effect)));
+    match solver {
+        Solver::Dftl => {
+            scene.grabs.clear();
+            scene.rod = None;
+        }
+        Solver::Rod => {
+            scene.dftl = None;
+            scene.dt = scene.dt.min(ROD_DT_MAX);
+            let rod = scene.rod.get_or_insert_with(RodSpec::default);
+            rod.twist = Some(row.twist.into());
+        }
+    }
+    scene
+}
+
+fn run_sim<const N: usize>(prepared: &Prepared, steps: u64, layout: Layout, threads: usize) -> u64 {
+    let mut sim =
+        Sim::<N, DefaultMath>::with_layout(prepared, threads, layout).expect("the scene builds");
+    sim.in_pool(|sim| {
+        for k in 0..steps {
+            sim.step(&scene_inputs::<DefaultMath>(prepared, k));
+        }
+    });
+    assert!(sim.is_finite());
+    sim.state_hash()
+}
+
+fn hash_of(prepared: &Prepared, steps: u64, layout: Layout, threads: usize) -> u64 {
+    match capacity_for(prepared.max_nodes()).expect("a capacity of this build") {
+        16 => run_sim::<16>(prepared, steps, layout, threads),
+        32 => run_sim::<32>(prepared, steps, layout, threads),
+        64 => run_sim::<64>(prepared, steps, layout, threads),
+        _ => run_sim::<128>(prepared, steps, layout, threads),
+    }
+}
+
+/// The row's one hash, after checking that every layout and thread count gives it.
+fn row_hash(row: &Golden) -> u64 {
+    let prepared = configured(row).prepare().expect("the scene prepares");
+    let mut hashes = Vec::new();
+    for layout in [Layout::PerStrand, Layout::Blocks] {
+        for threads in [1, 2] {
+            hashes.push((
+                layout,
+                threads,
+                hash_of(&prepared, row.steps, layout, threads),
+            ));
+        }
+    }
+    let first = hashes[0].2;
+    for (layout, threads, hash) in &hashes {
+        assert_eq!(
+            *hash, first,
+            "{} {} {}: {layout:?} on {threads} threads gives {hash:#018x}, per strand on 1 \
+             thread {first:#018x}",
+            row.scene, row.solver, row.twist
+        );
+    }
+    first
+}
+
+#[test]
+fn every_builtin_scene_has_rows() {
+    for builtin in BUILTINS {
+        assert!(
+            TABLE.iter().any(|row| row.scene == builtin.name),
+            "built-in scene {} has no golden hash",
+            builtin.name
+        );
+    }
+}
+
+#[test]
+fn state_hashes_are_the_recorded_ones() {
+    let print = std::env::var_os("HAIRSIM_GOLDEN_PRINT").is_some();
+    let mut wrong = Vec::new();
+    for row in TABLE {
+        let hash = row_hash(row);
+        if print {
+            println!(
+                "    g({:?}, {:?}, {:?}, {}, {hash:#018x}),",
+                row.scene, row.solver, row.twist, row.steps
+            );
+        }
+        if hash != row.hash {
+            wrong.push(format!(
+                "{} {} {} after {} steps: {hash:#018x}, recorded {:#018x}",
+                row.scene, row.solver, row.twist, row.steps, row.hash
+            ));
+        }
+    }
+    assert!(
+        wrong.is_empty(),
+        "state hashes moved:\n{}",
+        wrong.join("\n")
+    );
+}
+
+/// The native configuration of each built-in scene gives its golden hash through `hairsim run`
+/// (the command line's path, with its own set-up), not only through [`Sim`].
+#[test]
+fn the_command_line_gives_the_recorded_hashes() {
+    for builtin in BUILTINS {
+        let native = (builtin.scene)();
+        let row = TABLE
+            .iter()
+            .find(|row| {
+                row.scene == builtin.name
+                    && row.solver == native.solver
+                    && (row.solver == "dftl"
+                        || row.twist
+                            == native
+                                .rod
+                                .as_ref()
+                                .and_then(|r| r.twist.as_deref())
+                                .unwrap_or("hair-optimised"))
+            })
+            .expect("a row for the native configuration");
+        let options = RunOptions {
+            steps: Some(row.steps),
+            ..RunOptions::default()
+        };
+        let summary = run_builtin(builtin.name, &options).expect("the scene runs");
+        assert_eq!(
+            summary.state_hash,
+            format!("{:#018x}", row.hash),
+            "hairsim run {} --steps {}",
+            builtin.name,
+            row.steps
+        );
+    }
+}
