@@ -1,0 +1,516 @@
+//! The C functions called from Rust: the firmware scene through them gives the core's hash,
+//! the helpers give the scene's bits, and every refused case has its code.
+// Every pointer passed below is to a live local or buffer of the stated type and length, or
+// deliberately NULL, misaligned or overlapping the world (which the functions refuse unread).
+#![allow(clippy::undocumented_unsafe_blocks)]
+
+use std::boxed::Box;
+use std::format;
+use std::vec;
+use std::vec::Vec;
+
+use hairsim_core::scenes::firmware;
+use hairsim_core::{DefaultMath, World};
+
+use crate::scene_header::{self, Scene};
+use crate::*;
+
+use hairsim_error as E;
+
+/// A zeroed, 8-byte aligned buffer of `WORLD_SIZE` bytes, as a C `static` would be.
+struct Storage(Vec<u64>);
+
+impl Storage {
+    fn new() -> Storage {
+        Storage(vec![0; WORLD_SIZE.div_ceil(8) + 1])
+    }
+    fn world(&mut self) -> *mut hairsim_world {
+        self.0.as_mut_ptr().cast()
+    }
+    fn len(&self) -> usize {
+        self.0.len() * 8
+    }
+    fn init(&mut self) -> *mut hairsim_world {
+        let len = self.len();
+        let world = self.world();
+        assert_eq!(unsafe { hairsim_init(world, len) }, E::Ok);
+        world
+    }
+}
+
+fn step_time(k: u32, dt: f32) -> f32 {
+    (k + 1) as f32 * dt
+}
+
+/// Builds the firmware scene through the C functions, as the C programs do.
+fn build(world: *mut hairsim_world, scene: &Scene) {
+    unsafe {
+        assert_eq!(hairsim_configure(world, &scene.params), E::Ok);
+        for c in &scene.colliders {
+            assert_eq!(hairsim_add_collider(world, c, ptr::null_mut()), E::Ok);
+        }
+        for (s, points) in scene.strands.iter().enumerate() {
+            let mut index = u32::MAX;
+            let code = hairsim_add_strand(
+                world,
+                points.as_ptr(),
+                points.len(),
+                &scene.material,
+                &mut index,
+            );
+            assert_eq!((code, index), (E::Ok, s as u32));
+        }
+        for g in &scene.grabs {
+            assert_eq!(hairsim_add_grab(world, g, ptr::null_mut()), E::Ok);
+        }
+    }
+}
+
+fn step(world: *mut hairsim_world, scene: &Scene, k: u32) -> hairsim_step_report {
+    let t = step_time(k, scene.params.dt);
+    let mut input = hairsim_step_input {
+        head: hairsim_pose::default(),
+        grab_targets: ptr::null(),
+        grab_target_count: 0,
+        accelerations: ptr::null(),
+        acceleration_count: 0,
+    };
+    let mut targets = [hairsim_vec3::default(); HAIRSIM_MAX_GRABS];
+    let mut report = core::mem::MaybeUninit::<hairsim_step_report>::uninit();
+    unsafe {
+        assert_eq!(hairsim_shake_pose(&scene.shake, t, &mut input.head), E::Ok);
+        for (target, circle) in targets.iter_mut().zip(&scene.circles) {
+            assert_eq!(hairsim_circle_target(circle, t, target), E::Ok);
+        }
+        input.grab_targets = targets.as_ptr();
+        input.grab_target_count = scene.circles.len();
+        assert_eq!(hairsim_step(world, &input, report.as_mut_ptr()), E::Ok);
+        report.assume_init()
+    }
+}
+
+fn hash(world: *mut hairsim_world) -> u64 {
+    let mut h = 0;
+    assert_eq!(unsafe { hairsim_state_hash(world, &mut h) }, E::Ok);
+    h
+}
+
+fn rust_firmware_hash() -> u64 {
+    let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, DefaultMath>> =
+        Box::default();
+    firmware::run(&mut world, firmware::STEPS).unwrap()
+}
+
+/// `generate-header.sh` reads the capacities and the world's layout from here.
+#[test]
+fn header_defines() {
+    std::println!("@HAIRSIM_CAPACITY_BEGIN@");
+    std::println!(
+        "/** Strand capacity of a world (HAIRSIM_STRANDS when the library was built). */"
+    );
+    std::println!("#define HAIRSIM_STRANDS {STRANDS}");
+    std::println!("/** Node capacity per strand (HAIRSIM_NODES when the library was built). */");
+    std::println!("#define HAIRSIM_NODES {NODES}");
+    std::println!(
+        "/** Bytes of a world buffer: measured on a 64-bit host, no fewer than a 32-bit target \
+         needs. */"
+    );
+    std::println!("#define HAIRSIM_WORLD_SIZE {WORLD_SIZE}");
+    std::println!("/** Alignment of a world buffer, bytes. */");
+    std::println!("#define HAIRSIM_WORLD_ALIGN {WORLD_ALIGN}");
+    std::println!("@HAIRSIM_CAPACITY_END@");
+    const { assert!(usize::BITS == 64, "measure on a 64-bit host") };
+}
+
+#[test]
+fn the_capacity_function_tells_the_layout() {
+    assert_eq!(WORLD_ALIGN, 8);
+    let mut capacity = hairsim_capacity::default();
+    assert_eq!(unsafe { hairsim_get_capacity(&mut capacity) }, E::Ok);
+    assert_eq!(capacity.world_size, WORLD_SIZE);
+    assert_eq!(
+        (capacity.strands, capacity.nodes),
+        (STRANDS as u32, NODES as u32)
+    );
+    std::println!("world: {WORLD_SIZE} bytes, aligned to {WORLD_ALIGN}");
+}
+
+#[test]
+fn the_firmware_scene_through_the_c_functions_gives_the_core_hash() {
+    let scene = Scene::firmware();
+    let mut storage = Storage::new();
+    let world = storage.init();
+    build(world, &scene);
+    let mut held = 0;
+    for k in 0..firmware::STEPS {
+        let report = step(world, &scene, k);
+        held += u32::from(report.flags & HAIRSIM_FLAG_ROLLED_BACK == 0);
+    }
+    assert_eq!(held, firmware::STEPS, "no strand rolled back");
+    let mut info = hairsim_world_info::default();
+    assert_eq!(unsafe { hairsim_get_info(world, &mut info) }, E::Ok);
+    assert_eq!(
+        (info.steps, info.strands, info.colliders, info.grabs),
+        (u64::from(firmware::STEPS), 4, 1, 1)
+    );
+    assert_eq!(hash(world), rust_firmware_hash());
+    std::println!("state_hash 0x{:016x}", hash(world));
+}
+
+#[test]
+fn the_helpers_give_the_scene_bits() {
+    let scene = Scene::firmware();
+    let dt = firmware::params().dt;
+    assert_eq!(scene.params.dt.to_bits(), dt.to_bits());
+    for k in 0..=firmware::STEPS + 10 {
+        let t = step_time(k, dt);
+        let mut pose = hairsim_pose::default();
+        assert_eq!(
+            unsafe { hairsim_shake_pose(&scene.shake, t, &mut pose) },
+            E::Ok
+        );
+        let expected = convert::pose_to_c(&firmware::input::<DefaultMath>(k).head);
+        assert_eq!(format!("{pose:?}"), format!("{expected:?}"), "step {k}");
+        let bits = |p: &hairsim_pose| {
+            [
+                p.position.x,
+                p.position.y,
+                p.position.z,
+                p.rotation.x,
+                p.rotation.y,
+                p.rotation.z,
+                p.rotation.w,
+            ]
+            .map(f32::to_bits)
+        };
+        assert_eq!(bits(&pose), bits(&expected), "step {k}");
+        let mut target = hairsim_vec3::default();
+        let code = unsafe { hairsim_circle_target(&scene.circles[0], t, &mut target) };
+        assert_eq!(code, E::Ok);
+        // The scene moves the grab to `grab_target(k + 1)` before step k.
+        let expected = firmware::grab_target::<DefaultMath>(k + 1);
+        assert_eq!(
+            [target.x, target.y, target.z].map(f32::to_bits),
+            [expected.x, expected.y, expected.z].map(f32::to_bits),
+            "step {k}"
+        );
+    }
+}
+
+#[test]
+fn hex_literals_are_exact() {
+    assert_eq!(scene_header::hex(0.001), "0x1.0624dep-10f");
+    assert_eq!(scene_header::hex(0.01), "0x1.47ae14p-7f");
+    assert_eq!(scene_header::hex(1.0), "0x1p+0f");
+    assert_eq!(scene_header::hex(-2.5), "-0x1.4p+1f");
+    assert_eq!(scene_header::hex(0.0), "0x0p+0f");
+    assert_eq!(scene_header::hex(-0.0), "-0x0p+0f");
+    assert_eq!(scene_header::hex(f32::MIN_POSITIVE / 4.0), "0x0.4p-126f");
+    // Every literal of the header parses back to its bits.
+    let parse = |s: &str| -> f32 {
+        let (negative, s) = s.strip_prefix('-').map_or((false, s), |r| (true, r));
+        let s = s.strip_prefix("0x").unwrap().strip_suffix('f').unwrap();
+        let (mantissa, power) = s.split_once('p').unwrap();
+        let (lead, fraction) = mantissa.split_once('.').unwrap_or((mantissa, ""));
+        let mut value = f64::from(u8::from_str_radix(lead, 16).unwrap());
+        for (i, d) in fraction.chars().enumerate() {
+            value += f64::from(d.to_digit(16).unwrap()) / 16f64.powi(i as i32 + 1);
+        }
+        let value = value * 2f64.powi(power.parse().unwrap());
+        (if negative { -value } else { value }) as f32
+    };
+    let scene = Scene::firmware();
+    for p in scene.strands.iter().flatten() {
+        for v in [p.x, p.y, p.z] {
+            assert_eq!(parse(&scene_header::hex(v)).to_bits(), v.to_bits());
+        }
+    }
+    for v in [0.001f32, 1.0e-30, 3.0e38, -7.25e-3, f32::MIN_POSITIVE / 3.0] {
+        assert_eq!(parse(&scene_header::hex(v)).to_bits(), v.to_bits(), "{v}");
+    }
+}
+
+#[test]
+fn scene_header_is_current() {
+    let text = scene_header::generate(&Scene::firmware()) + "\n";
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(scene_header::PATH);
+    if std::env::var_os("HAIRSIM_BLESS").is_some() {
+        std::fs::write(&path, &text).unwrap();
+    }
+    let committed = std::fs::read_to_string(&path).unwrap_or_default();
+    assert!(
+        committed == text,
+        "{} is stale: run `HAIRSIM_BLESS=1 cargo test` in ffi/",
+        path.display()
+    );
+}
+
+fn input(head: hairsim_pose) -> hairsim_step_input {
+    hairsim_step_input {
+        head,
+        grab_targets: ptr::null(),
+        grab_target_count: 0,
+        accelerations: ptr::null(),
+        acceleration_count: 0,
+    }
+}
+
+fn identity() -> hairsim_pose {
+    hairsim_pose {
+        position: hairsim_vec3::default(),
+        rotation: hairsim_quat {
+            w: 1.0,
+            ..Default::default()
+        },
+    }
+}
+
+#[test]
+fn refused_arguments_have_their_codes() {
+    let scene = Scene::firmware();
+    let mut storage = Storage::new();
+    let len = storage.len();
+    let world = storage.world();
+    let bytes = world.cast::<u8>();
+    // Misaligned pointers point into this, not into the world (which is refused first).
+    let mut scratch = vec![0u64; 64];
+    let scratch = scratch.as_mut_ptr().cast::<u8>();
+    unsafe {
+        // The world buffer.
+        assert_eq!(hairsim_init(ptr::null_mut(), len), E::NullPointer);
+        assert_eq!(hairsim_init(bytes.add(4).cast(), len - 8), E::Misaligned);
+        assert_eq!(hairsim_init(world, WORLD_SIZE - 1), E::BufferTooSmall);
+        assert_eq!(hairsim_init(world, 0), E::BufferTooSmall);
+        // Before initialisation.
+        assert_eq!(hairsim_configure(world, &scene.params), E::NotInitialised);
+        assert_eq!(
+            hairsim_step(world, &input(identity()), ptr::null_mut()),
+            E::NotInitialised
+        );
+        let mut h = 0u64;
+        assert_eq!(hairsim_state_hash(world, &mut h), E::NotInitialised);
+        assert_eq!(hairsim_init(world, WORLD_SIZE), E::Ok);
+        // Re-entry: a call is running (as an interrupted call leaves it).
+        let state = &*world.cast::<AtomicU32>();
+        state.store(BUSY, Ordering::SeqCst);
+        assert_eq!(hairsim_state_hash(world, &mut h), E::Busy);
+        assert_eq!(hairsim_init(world, WORLD_SIZE), E::Busy);
+        assert_eq!(
+            hairsim_step(world, &input(identity()), ptr::null_mut()),
+            E::Busy
+        );
+        state.store(IDLE, Ordering::SeqCst);
+        assert_eq!(hairsim_state_hash(world, &mut h), E::Ok);
+
+        // Parameters.
+        let mut params = scene.params;
+        assert_eq!(hairsim_configure(world, ptr::null()), E::NullPointer);
+        params.dt = f32::NAN;
+        assert_eq!(hairsim_configure(world, &params), E::NotFinite);
+        params.dt = 1.0;
+        assert_eq!(hairsim_configure(world, &params), E::OutOfRange);
+        params = scene.params;
+        params.solver = 7;
+        assert_eq!(hairsim_configure(world, &params), E::OutOfRange);
+        params = scene.params;
+        params.effects |= 1 << 20;
+        assert_eq!(hairsim_configure(world, &params), E::OutOfRange);
+        params = scene.params;
+        params.rod_projection_iterations = 70_000;
+        assert_eq!(hairsim_configure(world, &params), E::OutOfRange);
+        params.rod_projection_iterations = 0;
+        assert_eq!(hairsim_configure(world, &params), E::OutOfRange);
+        params = scene.params;
+        params.rod_twist = 2;
+        assert_eq!(hairsim_configure(world, &params), E::OutOfRange);
+        params = scene.params;
+        params.solver = hairsim_solver::Dftl as u32;
+        params.dt = 0.001;
+        assert_eq!(hairsim_configure(world, &params), E::UnsupportedEffect);
+        let misaligned = scratch.add(2).cast::<hairsim_params>();
+        assert_eq!(hairsim_configure(world, misaligned), E::Misaligned);
+        assert_eq!(hairsim_configure(world, &scene.params), E::Ok);
+
+        // Strands.
+        let points = &scene.strands[3];
+        let m = &scene.material;
+        let add = |p: *const hairsim_vec3, n: usize, m: *const hairsim_material| {
+            hairsim_add_strand(world, p, n, m, ptr::null_mut())
+        };
+        assert_eq!(add(ptr::null(), 5, m), E::NullPointer);
+        assert_eq!(add(points.as_ptr(), 5, ptr::null()), E::NullPointer);
+        assert_eq!(add(points.as_ptr(), 2, m), E::TooFewNodes);
+        assert_eq!(add(points.as_ptr(), NODES + 1, m), E::TooManyNodes);
+        assert_eq!(add(points.as_ptr(), usize::MAX, m), E::TooManyNodes);
+        let mut bad = points.clone();
+        bad[4].y = f32::INFINITY;
+        assert_eq!(add(bad.as_ptr(), bad.len(), m), E::NotFinite);
+        bad = points.clone();
+        bad[4] = bad[3];
+        assert_eq!(add(bad.as_ptr(), bad.len(), m), E::DegenerateSegment);
+        bad = points.clone();
+        bad[4] = bad[2];
+        assert_eq!(add(bad.as_ptr(), bad.len(), m), E::FoldedSegment);
+        let mut material = *m;
+        material.radius = -1.0;
+        assert_eq!(add(points.as_ptr(), 5, &material), E::InvalidMaterial);
+        material.radius = f32::NAN;
+        assert_eq!(add(points.as_ptr(), 5, &material), E::NotFinite);
+        let odd = scratch.add(1).cast::<u32>();
+        let code = hairsim_add_strand(world, points.as_ptr(), 5, m, odd);
+        assert_eq!(code, E::Misaligned);
+        for s in 0..STRANDS {
+            let mut index = 0;
+            let code = hairsim_add_strand(world, points.as_ptr(), points.len(), m, &mut index);
+            assert_eq!((code, index), (E::Ok, s as u32));
+        }
+        assert_eq!(add(points.as_ptr(), points.len(), m), E::StrandsFull);
+
+        // Colliders.
+        let sphere = scene.colliders[0];
+        let mut c = sphere;
+        c.radius = -1.0;
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::InvalidCollider
+        );
+        c.shape = 3;
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::OutOfRange
+        );
+        c = sphere;
+        c.attached_to_head = 2;
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::OutOfRange
+        );
+        c = sphere;
+        c.a.z = f32::NAN;
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::NotFinite
+        );
+        for _ in 0..HAIRSIM_MAX_COLLIDERS {
+            assert_eq!(hairsim_add_collider(world, &sphere, ptr::null_mut()), E::Ok);
+        }
+        let code = hairsim_add_collider(world, &sphere, ptr::null_mut());
+        assert_eq!(code, E::CollidersFull);
+
+        // Grabs.
+        let grab = scene.grabs[0];
+        let mut g = grab;
+        g.node = 99;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        g = grab;
+        g.strand = 99;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        g = grab;
+        g.force_limit = 0.0;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        g.force_limit = f32::NAN;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::NotFinite);
+        for _ in 0..HAIRSIM_MAX_GRABS {
+            assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::Ok);
+        }
+        assert_eq!(
+            hairsim_add_grab(world, &grab, ptr::null_mut()),
+            E::GrabsFull
+        );
+        assert_eq!(hairsim_release_grab(world, 4), E::OutOfRange);
+        assert_eq!(hairsim_release_grab(world, 3), E::Ok);
+
+        // Steps.
+        let before = hash(world);
+        let mut head = identity();
+        head.rotation.w = f32::NAN;
+        assert_eq!(
+            hairsim_step(world, &input(head), ptr::null_mut()),
+            E::NotFinite
+        );
+        head.rotation.w = 2.0;
+        assert_eq!(
+            hairsim_step(world, &input(head), ptr::null_mut()),
+            E::OutOfRange
+        );
+        let mut i = input(identity());
+        let targets = [grab.target; 5];
+        i.grab_targets = targets.as_ptr();
+        i.grab_target_count = 5;
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::OutOfRange);
+        i.grab_target_count = 1;
+        i.grab_targets = ptr::null();
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::NullPointer);
+        let nan = [hairsim_vec3 {
+            x: f32::NAN,
+            ..Default::default()
+        }];
+        i.grab_targets = nan.as_ptr();
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::NotFinite);
+        let mut i = input(identity());
+        let accelerations = vec![hairsim_vec3::default(); STRANDS * NODES + 1];
+        i.accelerations = accelerations.as_ptr();
+        i.acceleration_count = accelerations.len();
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::OutOfRange);
+        i.accelerations = world.cast();
+        i.acceleration_count = 4;
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::Overlap);
+        let report = scratch.add(2).cast::<hairsim_step_report>();
+        assert_eq!(
+            hairsim_step(world, &input(identity()), report),
+            E::Misaligned
+        );
+        assert_eq!(hash(world), before, "a refused step changes nothing");
+        i.accelerations = accelerations.as_ptr();
+        i.acceleration_count = STRANDS * NODES;
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::Ok);
+        assert_ne!(hash(world), before);
+
+        // Positions.
+        let mut out = [hairsim_vec3::default(); 64];
+        let mut count = 0usize;
+        let code = hairsim_strand_positions(world, 0, out.as_mut_ptr(), 3, &mut count);
+        assert_eq!((code, count), (E::BufferTooSmall, points.len()));
+        let code = hairsim_strand_positions(world, 0, ptr::null_mut(), 0, &mut count);
+        assert_eq!(code, E::BufferTooSmall);
+        let code = hairsim_strand_positions(world, 0, ptr::null_mut(), 3, &mut count);
+        assert_eq!(code, E::NullPointer);
+        let code = hairsim_strand_positions(world, 99, out.as_mut_ptr(), 64, &mut count);
+        assert_eq!(code, E::OutOfRange);
+        let code = hairsim_strand_positions(world, 0, world.cast(), 64, &mut count);
+        assert_eq!(code, E::Overlap);
+        let code = hairsim_strand_positions(world, 0, out.as_mut_ptr(), 64, ptr::null_mut());
+        assert_eq!(code, E::Ok);
+        assert_eq!(out[0], points[0]);
+        let odd = scratch.add(1).cast::<u64>();
+        assert_eq!(hairsim_state_hash(world, odd), E::Misaligned);
+        assert_eq!(hairsim_state_hash(world, ptr::null_mut()), E::NullPointer);
+
+        // Helpers.
+        let mut pose = hairsim_pose::default();
+        let code = hairsim_shake_pose(&scene.shake, f32::NAN, &mut pose);
+        assert_eq!(code, E::NotFinite);
+        let mut shake = scene.shake;
+        shake.axis.x = 1.0;
+        assert_eq!(hairsim_shake_pose(&shake, 0.5, &mut pose), E::OutOfRange);
+        let mut circle = scene.circles[0];
+        circle.start.x = f32::MAX;
+        circle.radius = f32::MAX;
+        let mut target = hairsim_vec3::default();
+        // cos − 1 ≈ −2 half a turn in: −MAX · 2 overflows.
+        let code = hairsim_circle_target(&circle, 0.25, &mut target);
+        assert_eq!(code, E::NotFinite);
+        assert_eq!(
+            hairsim_circle_target(ptr::null(), 0.0, &mut target),
+            E::NullPointer
+        );
+
+        // Every code has a message; unknown ones too.
+        for code in -2..=25 {
+            let message = core::ffi::CStr::from_ptr(hairsim_error_message(code));
+            assert!(!message.is_empty());
+            let unknown = message.to_str().unwrap() == "unknown error code";
+            assert_eq!(unknown, !(0..=19).contains(&code), "{code}");
+        }
+    }
+}

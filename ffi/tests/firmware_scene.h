@@ -1,0 +1,26 @@
+/*
+ * The scene `firmware` of hairsim_core::scenes (the world `hairsim run firmware` steps),
+ * built and stepped through the general functions of hairsim.h only, from the data in
+ * firmware_scene_data.h. Shared by the host test (ffi/tests/host.c) and the bare-metal
+ * example (firmware-c/).
+ */
+#ifndef HAIRSIM_FIRMWARE_SCENE_H
+#define HAIRSIM_FIRMWARE_SCENE_H
+
+#include <stdint.h>
+
+#include "hairsim.h"
+
+/** Steps the scene runs before its state hash is compared (1000). */
+extern const uint32_t firmware_scene_steps;
+
+/** Configures an initialised, empty world and adds the scene's colliders, strands and grabs. */
+hairsim_error firmware_scene_build(hairsim_world *world);
+
+/**
+ * Step k (0-based) of the scene: at t = (k + 1) dt, the head's pose of the shake and the grab
+ * targets on their circles, then one hairsim_step. `report` may be NULL.
+ */
+hairsim_error firmware_scene_step(hairsim_world *world, uint32_t k, hairsim_step_report *report);
+
+#endif /* HAIRSIM_FIRMWARE_SCENE_H */
