@@ -44,8 +44,6 @@ static uint32_t stack_used(uintptr_t top) {
     return (uint32_t)(top - (uintptr_t)p);
 }
 
-static int finite(float x) { return x == x && x - x == 0.0f; }
-
 static int fail(const char *what, hairsim_error e) {
     line l = {0};
     line_str(&l, "error: ");
@@ -102,51 +100,31 @@ int main(void) {
     }
 
     stack_paint();
-    hairsim_step_report report;
     uint32_t rolled_back = 0;
-    for (uint32_t k = 0; e == HAIRSIM_ERROR_OK && k < firmware_scene_steps; k++) {
-        e = firmware_scene_step(world, k, &report);
-        rolled_back += report.rolled_back;
-    }
+    e = firmware_scene_run(world, &rolled_back);
     const uint32_t step_stack = stack_used(top);
     if (e != HAIRSIM_ERROR_OK) {
         return fail("a step", e);
     }
 
-    hairsim_world_info info;
-    e = hairsim_get_info(world, &info);
-    int all_finite = 1;
-    for (uint32_t s = 0; e == HAIRSIM_ERROR_OK && s < info.strands; s++) {
-        hairsim_vec3 positions[HAIRSIM_NODES];
-        size_t count = 0;
-        e = hairsim_strand_positions(world, s, positions, HAIRSIM_NODES, &count);
-        for (size_t i = 0; i < count; i++) {
-            all_finite &= finite(positions[i].x) & finite(positions[i].y) & finite(positions[i].z);
-        }
-    }
-    if (e == HAIRSIM_ERROR_OK) {
-        e = hairsim_state_hash(world, &hash);
-    }
+    firmware_scene_summary summary;
+    e = firmware_scene_summarise(world, &summary);
     if (e != HAIRSIM_ERROR_OK) {
         return fail("reading the world", e);
-    }
-    uint32_t held = 0;
-    for (uint32_t g = 0; g < info.grabs; g++) {
-        held += info.grab_status[g] == HAIRSIM_GRAB_STATUS_HELD;
     }
 
     /* The line CI compares with the host's hash. */
     line_str(&l, "scene firmware steps ");
-    line_u32(&l, (uint32_t)info.steps);
+    line_u32(&l, (uint32_t)summary.steps);
     line_str(&l, " strands ");
-    line_u32(&l, info.strands);
-    line_str(&l, all_finite ? " finite true" : " finite false");
+    line_u32(&l, summary.strands);
+    line_str(&l, summary.all_finite ? " finite true" : " finite false");
     line_str(&l, " grabs held ");
-    line_u32(&l, held);
+    line_u32(&l, summary.grabs_held);
     line_str(&l, " rolled back ");
     line_u32(&l, rolled_back);
     line_str(&l, " state_hash ");
-    line_hex64(&l, hash);
+    line_hex64(&l, summary.state_hash);
     line_print(&l);
 
     line_str(&l, "stack high-water mark, bytes: hairsim_init ");
@@ -172,5 +150,5 @@ int main(void) {
         semihosting_write0("error: the stack overflowed its 32 KiB\n");
         return 1;
     }
-    return all_finite ? 0 : 1;
+    return summary.all_finite ? 0 : 1;
 }

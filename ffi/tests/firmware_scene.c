@@ -43,3 +43,45 @@ hairsim_error firmware_scene_step(hairsim_world *world, uint32_t k, hairsim_step
     input.grab_target_count = FIRMWARE_GRABS;
     return hairsim_step(world, &input, report);
 }
+
+hairsim_error firmware_scene_run(hairsim_world *world, uint32_t *rolled_back) {
+    hairsim_error e = HAIRSIM_ERROR_OK;
+    *rolled_back = 0;
+    for (uint32_t k = 0; e == HAIRSIM_ERROR_OK && k < firmware_scene_steps; k++) {
+        hairsim_step_report report;
+        e = firmware_scene_step(world, k, &report);
+        *rolled_back += report.rolled_back;
+    }
+    return e;
+}
+
+/* Finite without a math library: NaN fails x == x, ±∞ gives NaN for x − x. */
+static int finite(float x) { return x == x && x - x == 0.0f; }
+
+hairsim_error firmware_scene_summarise(hairsim_world *world, firmware_scene_summary *out) {
+    hairsim_world_info info;
+    hairsim_error e = hairsim_get_info(world, &info);
+    out->all_finite = 1;
+    for (uint32_t s = 0; e == HAIRSIM_ERROR_OK && s < info.strands; s++) {
+        hairsim_vec3 positions[HAIRSIM_NODES];
+        size_t count = 0;
+        e = hairsim_strand_positions(world, s, positions, HAIRSIM_NODES, &count);
+        for (size_t i = 0; i < count; i++) {
+            out->all_finite &=
+                finite(positions[i].x) & finite(positions[i].y) & finite(positions[i].z);
+        }
+    }
+    if (e == HAIRSIM_ERROR_OK) {
+        e = hairsim_state_hash(world, &out->state_hash);
+    }
+    if (e != HAIRSIM_ERROR_OK) {
+        return e;
+    }
+    out->steps = info.steps;
+    out->strands = info.strands;
+    out->grabs_held = 0;
+    for (uint32_t g = 0; g < info.grabs; g++) {
+        out->grabs_held += info.grab_status[g] == HAIRSIM_GRAB_STATUS_HELD;
+    }
+    return HAIRSIM_ERROR_OK;
+}

@@ -23,4 +23,20 @@ hairsim_error firmware_scene_build(hairsim_world *world);
  */
 hairsim_error firmware_scene_step(hairsim_world *world, uint32_t k, hairsim_step_report *report);
 
+/** Steps 0 … firmware_scene_steps − 1, adding up the strands each step rolled back. */
+hairsim_error firmware_scene_run(hairsim_world *world, uint32_t *rolled_back);
+
+/** What both programs print of the world after the run (the line CI compares). */
+typedef struct firmware_scene_summary {
+    uint64_t steps;
+    uint32_t strands;
+    /** 1 when every node position is finite. */
+    int all_finite;
+    uint32_t grabs_held;
+    uint64_t state_hash;
+} firmware_scene_summary;
+
+/** Reads the summary of `world`. */
+hairsim_error firmware_scene_summarise(hairsim_world *world, firmware_scene_summary *out);
+
 #endif /* HAIRSIM_FIRMWARE_SCENE_H */

@@ -62,8 +62,6 @@ static void check(int ok, const char *what) {
     }
 }
 
-static int finite(float x) { return x == x && x - x == 0.0f; }
-
 /* The scene, 1,000 steps: returns 0 and the hash, or 1. */
 static int run_scene(uint64_t *hash) {
     hairsim_world *world = (hairsim_world *)scene_storage;
@@ -72,40 +70,24 @@ static int run_scene(uint64_t *hash) {
         e = firmware_scene_build(world);
     }
     uint32_t rolled_back = 0;
-    for (uint32_t k = 0; e == HAIRSIM_ERROR_OK && k < firmware_scene_steps; k++) {
-        hairsim_step_report report;
-        e = firmware_scene_step(world, k, &report);
-        rolled_back += report.rolled_back;
-    }
-    hairsim_world_info info;
     if (e == HAIRSIM_ERROR_OK) {
-        e = hairsim_get_info(world, &info);
+        e = firmware_scene_run(world, &rolled_back);
     }
-    int all_finite = 1;
-    for (uint32_t s = 0; e == HAIRSIM_ERROR_OK && s < info.strands; s++) {
-        hairsim_vec3 positions[HAIRSIM_NODES];
-        size_t count = 0;
-        e = hairsim_strand_positions(world, s, positions, HAIRSIM_NODES, &count);
-        for (size_t i = 0; i < count; i++) {
-            all_finite &= finite(positions[i].x) & finite(positions[i].y) & finite(positions[i].z);
-        }
-    }
+    firmware_scene_summary summary;
     if (e == HAIRSIM_ERROR_OK) {
-        e = hairsim_state_hash(world, hash);
+        e = firmware_scene_summarise(world, &summary);
     }
     if (e != HAIRSIM_ERROR_OK) {
         printf("error: the firmware scene: %s\n", hairsim_error_message(e));
         return 1;
     }
-    unsigned held = 0;
-    for (uint32_t g = 0; g < info.grabs; g++) {
-        held += info.grab_status[g] == HAIRSIM_GRAB_STATUS_HELD;
-    }
+    *hash = summary.state_hash;
     printf("scene firmware steps %llu strands %u finite %s grabs held %u rolled back %u "
            "state_hash 0x%016llx\n",
-           (unsigned long long)info.steps, (unsigned)info.strands, all_finite ? "true" : "false",
-           held, (unsigned)rolled_back, (unsigned long long)*hash);
-    return !all_finite;
+           (unsigned long long)summary.steps, (unsigned)summary.strands,
+           summary.all_finite ? "true" : "false", (unsigned)summary.grabs_held,
+           (unsigned)rolled_back, (unsigned long long)summary.state_hash);
+    return !summary.all_finite;
 }
 
 /* Every refused argument, with its code. */
