@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use hairsim_benches::cpu_seconds;
 use hairsim_core::context::StepContext;
-use hairsim_core::dftl::{step_blocks, DftlBlock};
+use hairsim_core::dftl::DftlBlock;
+use hairsim_core::step_blocks;
 use hairsim_core::{
     step_strands, Effect, Effects, Material, Math, Params, Real, Shake, Solver, StepReport, Strand,
     Vec3,

@@ -2,8 +2,7 @@
 
 use crate::math::{Real, Vec3};
 
-/// Most grabs a world holds.
-pub const MAX_GRABS: usize = 4;
+pub use crate::capacities::MAX_GRABS;
 
 /// Whether a grab holds its node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -146,6 +145,17 @@ pub fn grabbed_nodes(
         }
     }
     held
+}
+
+/// Moves `grab`'s target to `target` if it is finite (the caller's input: a non-finite
+/// target is ignored). Returns whether it moved.
+pub fn retarget(grab: &mut Grab, target: Vec3) -> bool {
+    if crate::math::is_finite(target) {
+        grab.target = target;
+        true
+    } else {
+        false
+    }
 }
 
 /// After a step: every grab whose bit is set in `report.grabs_slipped` stops holding its node.

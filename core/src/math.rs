@@ -112,6 +112,13 @@ pub fn is_finite(v: Vec3) -> bool {
     v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
 }
 
+/// `v / |v|` as `v · (1/|v|)`, with the backend's square root.
+#[inline]
+#[must_use]
+pub fn unit<M: Math>(v: Vec3) -> Vec3 {
+    v * (1.0 / M::length(v))
+}
+
 /// Rotates `v` by the unit quaternion `q` with scalar code written out here, so the order of
 /// every sum is fixed on every target (glam's SSE2 quaternion code sums in another order).
 #[inline(always)]

@@ -10,9 +10,11 @@
 //! square root and a division per node). The step's tangent comes from the follow-the-leader
 //! projection, which already has `1/|e|`, so a frame costs no square root at all.
 
+use crate::lane::{Lane, V3};
 use crate::math::{self, Math, Quat, Vec3};
 
-use super::lane::{Lane, V3};
+use super::measures::Segment;
+use super::node::Chain;
 
 /// The frame whose x-axis is the unit vector `t`, the minimal rotation from `e_x` (`R̂_0`).
 /// A `t` opposite to `e_x` turns half a turn about z.
@@ -44,6 +46,32 @@ pub fn transport<T: Lane>(tangent: V3<T>, normal: V3<T>, t: V3<T>) -> V3<T> {
     let one_plus_c = T::splat(1.0) + c;
     let turned = normal.scale(c) + k.cross(normal) + k.scale(k.dot(normal) / one_plus_c);
     V3::select(T::splat(1e-6).lt(one_plus_c), turned, normal)
+}
+
+/// SB15 Algorithm 1 line 21: the frame of the final node `i` carried from node `i − 1`'s
+/// (`chain`). Its tangent is `tangent` where `known` (follow-the-leader's, when no collider
+/// moved the node), else the unit edge of `segment` (`chain`'s tangent for a zero edge); its
+/// normal is [`transport`]ed. Returns `(t_i, n_i)`.
+#[inline(always)]
+#[must_use]
+pub fn carry<M: Math, T: Lane>(
+    chain: &Chain<T>,
+    segment: &Segment<T>,
+    tangent: V3<T>,
+    known: T::Mask,
+) -> (V3<T>, V3<T>) {
+    let t = if T::all(known) {
+        tangent
+    } else {
+        let length = segment.squared_length.sqrt::<M>();
+        let exact = V3::select(
+            T::splat(0.0).lt(length),
+            segment.edge.scale(T::splat(1.0) / length),
+            chain.tangent,
+        );
+        V3::select(known, tangent, exact)
+    };
+    (t, transport(chain.tangent, chain.normal, t))
 }
 
 /// `R v = v_x t + v_y n + v_z (t × n)`: a vector given in the frame `(t, n)`, in world axes.
