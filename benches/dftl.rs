@@ -12,7 +12,8 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use hairsim_core::context::StepContext;
-use hairsim_core::dftl::{step_blocks, DftlBlock};
+use hairsim_core::dftl::DftlBlock;
+use hairsim_core::step_blocks;
 use hairsim_core::{
     step_strands, Effect, Effects, Material, Math, Params, Pose, Real, Shake, Solver, StepReport,
     Strand, Vec3,

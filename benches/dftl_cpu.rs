@@ -12,7 +12,8 @@ use std::time::Instant;
 
 use hairsim_benches::cpu_seconds;
 use hairsim_core::context::StepContext;
-use hairsim_core::dftl::{step_blocks, DftlBlock};
+use hairsim_core::dftl::DftlBlock;
+use hairsim_core::step_blocks;
 use hairsim_core::{
     step_strands, Effect, Effects, Material, Math, Params, Real, Shake, Solver, StepReport, Strand,
     Vec3,
@@ -188,10 +189,9 @@ fn size<const N: usize>(count: usize, quick: bool) {
 
 /// The state hash of 64 strands × 32 nodes after 200 shaking steps of DFTL + shape, by the
 /// per-strand path and by 16-lane blocks. Recorded on the default x86-64 target; the check
-/// that `-C target-cpu=native` (AVX-512 here) gives the same bits. (Session 10 re-recorded it:
-/// the hash covers the material angles `θ`, which DFTL carries at their rest values without
-/// reading them, and the hair-optimised twist's new arithmetic changed the rest angles'
-/// bits. Until then it was `0xe1b5_95c1_fe97_f9b3`.)
+/// that `-C target-cpu=native` (AVX-512 here) gives the same bits. The hash covers the material
+/// angles `θ`, which DFTL carries at their rest values without reading them, so a change to
+/// the hair-optimised twist's arithmetic that moves the rest angles' bits moves it too.
 const EXPECTED_HASH: u64 = 0x5860_be10_588b_a366;
 
 fn check_hash() {

@@ -7,7 +7,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use hairsim_core::effects::{Effect, Effects};
 use hairsim_core::params::{Params, TwistMethod};
 use hairsim_core::rod::energy::{elastic_forces, RodFrames};
-use hairsim_core::rod::twist::{hair_optimised_twist, newton_twist};
+use hairsim_core::rod::twist::{hair_optimised_twist, newton_twist, NewtonSettings};
 use hairsim_core::rod::{ClampedSegments, ElasticTerms};
 use hairsim_core::{Libm, Material, Pose, StepInput, Strand, Vec3, World};
 use std::hint::black_box;
@@ -74,9 +74,11 @@ fn twist_table_2(c: &mut Criterion) {
                         &s.rest.rod,
                         &clamped,
                         ElasticTerms::ALL,
-                        10,
-                        1e-6,
-                        false,
+                        NewtonSettings {
+                            iterations: 10,
+                            tolerance: 1e-6,
+                            fixed_cost: false,
+                        },
                         &mut theta[..NODES - 1],
                     );
                     black_box((theta, outcome));

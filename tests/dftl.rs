@@ -4,7 +4,8 @@
 
 use hairsim_core::collide::{Collider, Shape};
 use hairsim_core::context::StepContext;
-use hairsim_core::dftl::{step_blocks, DftlBlock};
+use hairsim_core::dftl::DftlBlock;
+use hairsim_core::step_blocks;
 use hairsim_core::{
     Effect, Effects, Libm, Material, Math, Params, Pose, Real, Shake, Solver, StepInput,
     StepReport, Strand, Vec3, World,

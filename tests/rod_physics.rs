@@ -33,7 +33,7 @@ fn clamped_strand_sags_as_an_euler_bernoulli_cantilever() {
     // 100× human hair (α = 7.04e-7 N·m²), 33 nodes 2 mm apart, nodes 0 and 1 held level
     // (the clamp), gravity. Euler–Bernoulli: tip deflection w L⁴ / (8 EI) with w = ρA g and L
     // the free length from the discrete clamp's effective position, the middle of the first
-    // segment (DESIGN.md), here 63 mm: 1.0e-4 m, 0.16 % of L — small deflection. dt = 0.1 ms
+    // segment (`docs/architecture.md`, Kmoch Sec. 8.1), here 63 mm: 1.0e-4 m, 0.16 % of L — small deflection. dt = 0.1 ms
     // (94 fixed substeps: 2 mm segments of stiff hair), air drag 5e-6 kg/s per node (near
     // critical for the first mode, 46 Hz) settles it within 0.3 s.
     let (nodes, h) = (33, 0.002);

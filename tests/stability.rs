@@ -1,4 +1,4 @@
-//! Stability of the rod solver on a shaking head (DESIGN.md "Stability of explicit bending").
+//! Stability of the rod solver on a shaking head (`docs/design-departures.md`, the substep policy).
 //!
 //! The firmware scene (`hairsim_core::scenes::firmware`: four curved strands of 12–15 nodes
 //! with 1–6 cm segments, every rod effect on, the head shaking at 10 rad/s, a grab dragging
@@ -6,7 +6,7 @@
 //! With a substep count from the straight strand's limit and the hair-optimised twist, strand 1
 //! folded at its root after ~600 steps, its stiffest bending mode ran at 3× the explicit limit,
 //! and it blew up (1e4 m/s, projection residual 1e15, a rollback) in 10 of these 13 runs. Both
-//! twists now run all 13 with the fixed substep count (`rod::step`, fold allowance 4).
+//! twists now run all 13 with the fixed substep count (`rod::substeps`, fold allowance 4).
 //!
 //! Every step must keep: no rollback, stretch ≤ 1e-3, bounded kinetic energy, and a bounded
 //! turning-angle second difference ("chatter"), which a saw-tooth instability drives up. The

@@ -584,7 +584,7 @@ fn a_segment_folded_back_on_itself() {
     // unfolds a full hairpin (turning angle π − 0.01). The rod unfolds a start bend of 65°
     // (π − 2 rad) with its explicit substeps (≤ 2.6 m/s), and ones of 174° and 178° (π − 0.1
     // and π − 0.035 rad) with the implicit bending step, which a strand takes from the first
-    // step whose fold is sharper than its substeps hold (`RodRest::implicit_bending`; measured
+    // step whose fold is sharper than its substeps hold (`Schedule::implicit_bending`; measured
     // ≤ 3.4 and ≤ 3.7 m/s, chatter ≤ 0.28 rad, no roll-back). Before that switch a human hair
     // released from ≥ 94° whipped, turned non-finite and was rolled back every step. Not a
     // case: the exact hairpin (π − 0.01 rad), where `|κb| = 2 tan(φ/2)` ≈ 400 and the Bishop

@@ -5,8 +5,7 @@
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 
-/// Most colliders a world holds.
-pub const MAX_COLLIDERS: usize = 8;
+pub use crate::capacities::MAX_COLLIDERS;
 
 /// Smallest collider radius, m. Below it a contact row's gradient `2(x − c)` underflows f32
 /// (found by the projection fuzz target with a radius of 1e-20 m).

@@ -1,5 +1,5 @@
 //! The step context: everything derived once per step and shared by every strand (Box2D's
-//! `b2StepContext`, Jolt's hair update context).
+//! `b2StepContext`, Jolt's hair update context), the stages' gates among it.
 
 use crate::collide::{Collider, Shape, MAX_COLLIDERS};
 use crate::effects::{Effect, Effects};
@@ -32,6 +32,75 @@ pub struct StepContext {
     pub wind: Vec3,
     /// DFTL's coefficients at this `dt` (zero unless the solver is DFTL).
     pub dftl: DftlCoefficients,
+    /// Which stages and terms run this step, derived from `effects` and the colliders.
+    pub gates: Gates,
+}
+
+/// Which stages (and terms inside stages) a step runs: derived once from the scene's effects
+/// and colliders when the context is built (Jolt's `mNeedsCollision`, `mNeedsGrid`), so each
+/// line of a pipeline tests one of these and nothing else. An effect that is off costs
+/// nothing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Gates {
+    /// Bending forces (`bending`).
+    pub bending: bool,
+    /// Twist forces and the quasistatic twist (`twist`).
+    pub twist: bool,
+    /// The rod's frames: bending or twist.
+    pub frames: bool,
+    /// `gravity`.
+    pub gravity: bool,
+    /// `wind`.
+    pub wind: bool,
+    /// Air drag (`drag`).
+    pub drag: bool,
+    /// Any external force of the scene's own: gravity, wind or drag.
+    pub external: bool,
+    /// Inextensibility (`inextensibility`): the rod's projection rows, DFTL's follow-the-leader.
+    pub inextensibility: bool,
+    /// `collisions`.
+    pub collisions: bool,
+    /// `collisions` with at least one collider in use.
+    pub colliders: bool,
+    /// Grabs (`grabs`).
+    pub grabs: bool,
+    /// The rod's fast manifold projection: inextensibility, collisions or grabs.
+    pub projection: bool,
+    /// DFTL's global and local shape constraints (`shape`).
+    pub shape: bool,
+    /// SPH hair–hair interaction (`hair-hair`, computed by the std harness).
+    pub hair_hair: bool,
+}
+
+impl Gates {
+    /// The gates of `effects` with `colliders` colliders in use.
+    #[must_use]
+    pub const fn of(effects: Effects, colliders: usize) -> Gates {
+        let bending = effects.contains(Effect::Bending);
+        let twist = effects.contains(Effect::Twist);
+        let gravity = effects.contains(Effect::Gravity);
+        let wind = effects.contains(Effect::Wind);
+        let drag = effects.contains(Effect::Drag);
+        let inextensibility = effects.contains(Effect::Inextensibility);
+        let collisions = effects.contains(Effect::Collisions);
+        let grabs = effects.contains(Effect::Grabs);
+        Gates {
+            bending,
+            twist,
+            frames: bending || twist,
+            gravity,
+            wind,
+            drag,
+            external: gravity || wind || drag,
+            inextensibility,
+            collisions,
+            colliders: collisions && colliders > 0,
+            grabs,
+            projection: inextensibility || collisions || grabs,
+            shape: effects.contains(Effect::Shape),
+            hair_hair: effects.contains(Effect::HairHair),
+        }
+    }
 }
 
 impl StepContext {
@@ -89,6 +158,7 @@ impl StepContext {
             collider_count,
             wind: Vec3::ZERO,
             dftl,
+            gates: Gates::of(effects, collider_count),
         }
         .at_time(0.0)
     }
@@ -97,7 +167,7 @@ impl StepContext {
     #[must_use]
     pub fn at_time(mut self, t: Real) -> Self {
         if self.effects.contains(Effect::Wind) {
-            self.wind = crate::forces::wind_acceleration(&self.params.wind, t);
+            self.wind = crate::wind::wind_acceleration(&self.params.wind, t);
         }
         self
     }

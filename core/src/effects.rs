@@ -2,9 +2,7 @@
 //!
 //! The names are the same everywhere — scene files, the command line, JSON and code:
 //! `gravity`, `drag`, `bending`, `twist`, `inextensibility`, `collisions`, `shape`, `wind`,
-//! `grabs`, `hair-hair`.
-
-use crate::params::Solver;
+//! `grabs`, `hair-hair`. Which of them a [`Solver`] can simulate is decided here too.
 
 /// One effect a scene may turn on.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -130,6 +128,39 @@ impl Effects {
     #[must_use]
     pub fn unsupported_by(self, solver: Solver) -> Option<Effect> {
         self.iter().find(|e| !solver.supports(*e))
+    }
+}
+
+/// Which model steps the strands.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Solver {
+    /// Discrete Kirchhoff rods with fast manifold projection (Kmoch et al. 2009).
+    Rod,
+    /// Dynamic Follow-The-Leader with shape preservation (Sánchez-Banderas et al. 2015).
+    Dftl,
+}
+
+impl Solver {
+    /// The solver's name in scene files and reports (`"rod"`, `"dftl"`).
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Solver::Rod => "rod",
+            Solver::Dftl => "dftl",
+        }
+    }
+
+    /// Whether this solver can simulate `effect`: bending and twist need the rod's energies,
+    /// shape preservation is DFTL's.
+    #[must_use]
+    pub const fn supports(self, effect: Effect) -> bool {
+        match self {
+            Solver::Rod => !matches!(effect, Effect::Shape),
+            // DFTL has no grab constraint (its single root-to-tip pass cannot hold a middle
+            // node): refused, not silently ignored.
+            Solver::Dftl => !matches!(effect, Effect::Bending | Effect::Twist | Effect::Grabs),
+        }
     }
 }
 

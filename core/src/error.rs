@@ -24,7 +24,7 @@ pub enum BuildError {
         /// Index of the node, root = 0.
         node: usize,
     },
-    /// A segment is shorter than [`crate::strand::MIN_SEGMENT_LENGTH`].
+    /// A segment is shorter than [`crate::capacities::MIN_SEGMENT_LENGTH`].
     DegenerateSegment {
         /// Index of the segment (between nodes `segment` and `segment + 1`).
         segment: usize,
@@ -61,7 +61,7 @@ impl fmt::Display for BuildError {
             BuildError::DegenerateSegment { segment } => write!(
                 f,
                 "segment {segment} is shorter than {} m",
-                crate::strand::MIN_SEGMENT_LENGTH
+                crate::capacities::MIN_SEGMENT_LENGTH
             ),
             BuildError::FoldedSegment { node } => write!(
                 f,
@@ -83,12 +83,12 @@ pub enum CapacityError {
         /// The capacity `S`.
         capacity: usize,
     },
-    /// The world already holds [`crate::collide::MAX_COLLIDERS`] colliders.
+    /// The world already holds [`crate::capacities::MAX_COLLIDERS`] colliders.
     Colliders {
         /// The capacity.
         capacity: usize,
     },
-    /// The world already holds [`crate::grab::MAX_GRABS`] grabs.
+    /// The world already holds [`crate::capacities::MAX_GRABS`] grabs.
     Grabs {
         /// The capacity.
         capacity: usize,

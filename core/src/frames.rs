@@ -68,7 +68,8 @@ pub fn bishop_frame<P: Precision>(tangents: &[P::V], root_frame: P::V, u: &mut [
 #[must_use]
 pub fn transport_in_time<P: Precision>(old_tangent: P::V, new_tangent: P::V, u: P::V) -> P::V {
     let moved = parallel_transport::<P>(old_tangent, new_tangent, u);
-    orthonormalise::<P>(moved, new_tangent).unwrap_or_else(|| perpendicular_unit::<P>(new_tangent))
+    orthonormalise::<P>(moved, new_tangent)
+        .unwrap_or_else(|| perpendicular_unit_by_reciprocal::<P>(new_tangent))
 }
 
 /// `v` made perpendicular to the unit vector `t` and normalised; `None` if nothing is left.
@@ -84,9 +85,11 @@ pub fn orthonormalise<P: Precision>(v: P::V, t: P::V) -> Option<P::V> {
 }
 
 /// A unit vector perpendicular to `t`: `t` crossed with the coordinate axis least aligned with
-/// it (deterministic; the same choice as [`crate::strand::perpendicular_unit`]).
+/// it (deterministic), normalised by multiplying with the reciprocal of its length, in any
+/// precision. [`crate::strand::perpendicular_unit`] makes the same choice but divides by the
+/// length: other operations, other bits, so each keeps its own function.
 #[must_use]
-pub fn perpendicular_unit<P: Precision>(t: P::V) -> P::V {
+pub fn perpendicular_unit_by_reciprocal<P: Precision>(t: P::V) -> P::V {
     let v = P::to_vec3(t).abs();
     let axis = if v.x <= v.y && v.x <= v.z {
         crate::math::Vec3::X
@@ -102,6 +105,14 @@ pub fn perpendicular_unit<P: Precision>(t: P::V) -> P::V {
     } else {
         P::vector(crate::math::Vec3::X)
     }
+}
+
+/// The root segment's Bishop vector `u^0` at rest, which is also its rest material vector
+/// `m1^0` (`θ̂^0 = 0`): perpendicular to the rest root tangent. The state starts with it, and
+/// the head carries it to set `θ^0` each step.
+#[must_use]
+pub fn rest_root_frame<P: Precision>(root: P::V, next: P::V, rest_length: P::R) -> P::V {
+    perpendicular_unit_by_reciprocal::<P>((next - root) * (P::R::ONE / rest_length))
 }
 
 /// The material frame `(m1, m2)` of a segment with Bishop frame `(u, v)` and material angle
@@ -177,7 +188,11 @@ mod tests {
             unit(DVec3::new(-s.sin(), s.cos(), 0.5))
         });
         let mut u = [DVec3::ZERO; 40];
-        bishop_frame::<F64>(&tangents, perpendicular_unit::<F64>(tangents[0]), &mut u);
+        bishop_frame::<F64>(
+            &tangents,
+            perpendicular_unit_by_reciprocal::<F64>(tangents[0]),
+            &mut u,
+        );
         for (t, u) in tangents.iter().zip(&u) {
             assert!(t.dot(*u).abs() < 1e-12 && (u.length() - 1.0).abs() < 1e-12);
         }

@@ -2,8 +2,7 @@
 
 use crate::math::{Real, Vec3};
 
-/// Most grabs a world holds.
-pub const MAX_GRABS: usize = 4;
+pub use crate::capacities::MAX_GRABS;
 
 /// Whether a grab holds its node.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -64,7 +63,7 @@ impl Grab {
 /// The nodes of one strand that grabs hold this step: a set of at most [`MAX_GRABS`] entries,
 /// each a grab's index in the world's grab list and the node it pins.
 ///
-/// A held node is *prescribed* (infinite mass, no constraint rows — DESIGN.md, fast manifold
+/// A held node is *prescribed* (infinite mass, no constraint rows — `docs/architecture.md`, fast manifold
 /// projection) and its segment is clamped for the twist, like the root segment.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -148,6 +147,17 @@ pub fn grabbed_nodes(
     held
 }
 
+/// Moves `grab`'s target to `target` if it is finite (the caller's input: a non-finite
+/// target is ignored). Returns whether it moved.
+pub fn retarget(grab: &mut Grab, target: Vec3) -> bool {
+    if crate::math::is_finite(target) {
+        grab.target = target;
+        true
+    } else {
+        false
+    }
+}
+
 /// After a step: every grab whose bit is set in `report.grabs_slipped` stops holding its node.
 pub fn apply_slips(grabs: &mut [Grab], report: &crate::report::StepReport) {
     for (g, grab) in grabs.iter_mut().enumerate().take(MAX_GRABS) {
@@ -164,7 +174,7 @@ pub const REACH_SLACK: Real = 1.0e-3;
 /// and its bit is set in `report.grabs_slipped`.
 ///
 /// Holding it would take an unbounded force: the projection, asked for positions that do
-/// not exist (prescribed nodes carry no rows, DESIGN.md), stretches and kinks the strand
+/// not exist (prescribed nodes carry no rows), stretches and kinks the strand
 /// before the force limit lets go a step or two later, and the strand then whips from that
 /// state (measured in `tests/torture.rs`: chatter 3.5 rad). A target is out of reach when
 /// it is farther from the strand's head-held node 1 (where the head puts it this step), or

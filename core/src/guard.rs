@@ -1,10 +1,16 @@
-//! Quarantine (rapier's idea): a strand whose state turns non-finite — or, with
-//! inextensibility on, flies apart while staying finite — goes back to its last good state with
-//! zero velocity, and the report names it. A NaN never leaves a step.
+//! Quarantine, second half (rapier's idea): a strand whose state turns non-finite — or, with
+//! inextensibility on, flies apart while staying finite — goes back to the last good state its
+//! snapshot kept ([`crate::snapshot`]), with zero velocity, and the report names it. A NaN
+//! never leaves a step.
+//!
+//! One stage for every path ([`guard`]): the rod judges a strand after its step
+//! ([`sound`]); DFTL watches every value it writes during its pass and hands the guard its
+//! verdict per strand or per lane ([`crate::lane::not_finite`]).
 
-use crate::math::{Real, Vec3};
+use crate::math::Real;
 use crate::report::{Stage, StepReport};
-use crate::strand::{Strand, StrandState};
+use crate::snapshot::{LastGood, Strands};
+use crate::strand::Strand;
 
 /// How far past its arc length a node of an inextensible strand may lie from the root before
 /// the strand counts as blown up. No physical state comes near it (the projection holds
@@ -13,55 +19,37 @@ use crate::strand::{Strand, StrandState};
 /// limit), which a finiteness test alone lets through to the state hash and the pictures.
 pub const REACH_FACTOR: Real = 2.0;
 
-/// Checks `strand` after its step; if any value is non-finite, or `inextensible` and a node
-/// lies farther from the root than [`REACH_FACTOR`] times the arc length to it, restores
-/// `last_good`, zeroes the velocities and records the strand in `report`. Returns whether it
-/// rolled back.
-pub fn check<const N: usize>(
-    strand: &mut Strand<N>,
-    last_good: &StrandState<N>,
-    inextensible: bool,
-    index: u32,
+/// The guard stage: counts the strands through [`Stage::Guard`]; each strand `k` that is not
+/// `good(strands, k)` goes back to `last_good` at rest, and the report names it as strand
+/// `first + k`. Returns whether any strand rolled back.
+#[inline(always)]
+pub fn guard<S: Strands, K: LastGood<S>>(
+    strands: &mut S,
+    last_good: &K,
+    good: impl Fn(&S, usize) -> bool,
+    first: u32,
     report: &mut StepReport,
 ) -> bool {
-    report.ran(Stage::Guard);
-    if strand.is_finite() && (!inextensible || within_reach(strand)) {
-        return false;
+    let count = strands.count();
+    report.ran_on(Stage::Guard, count);
+    let mut rolled_back = false;
+    for k in 0..count as usize {
+        if good(strands, k) {
+            continue;
+        }
+        last_good.restore(strands, k);
+        report.roll_back(first.wrapping_add(k as u32));
+        rolled_back = true;
     }
-    strand.state.clone_from(last_good);
-    stop_and_report(strand, index, report);
-    true
+    rolled_back
 }
 
-/// The guard with its verdict already known, for a solver that watched every value it wrote
-/// (the DFTL step, [`crate::dftl::velocity::not_finite`]) and writes positions and velocities
-/// only (no twist, no root frame): a strand that is not `good` gets `last_good`, its positions
-/// at the start of the step, back — the last good state, since a roll-back zeroes the
-/// velocities anyway — and the report names it, as in [`check`]. Returns whether it rolled
-/// back.
-pub fn restore_positions_unless<const N: usize>(
-    good: bool,
-    strand: &mut Strand<N>,
-    last_good: &[Vec3; N],
-    index: u32,
-    report: &mut StepReport,
-) -> bool {
-    report.ran(Stage::Guard);
-    if good {
-        return false;
-    }
-    strand.state.position = *last_good;
-    stop_and_report(strand, index, report);
-    true
-}
-
-/// The rest of a roll-back: the restored strand starts from rest, and the report names it.
-fn stop_and_report<const N: usize>(strand: &mut Strand<N>, index: u32, report: &mut StepReport) {
-    let n = strand.rest.nodes;
-    for v in strand.state.velocity.iter_mut().take(n) {
-        *v = Vec3::ZERO;
-    }
-    report.roll_back(index);
+/// The rod's verdict on a strand after its step: every value finite and, if `inextensible`,
+/// every node within [`REACH_FACTOR`] times the rest arc length to it from the root.
+#[inline(always)]
+#[must_use]
+pub fn sound<const N: usize>(strand: &Strand<N>, inextensible: bool) -> bool {
+    strand.is_finite() && (!inextensible || within_reach(strand))
 }
 
 /// Whether every node lies within [`REACH_FACTOR`] times its rest arc length of the root
@@ -85,11 +73,23 @@ fn within_reach<const N: usize>(strand: &Strand<N>) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::strand::Material;
+    use crate::math::Vec3;
+    use crate::strand::{Material, StrandState};
 
     fn hanging() -> Strand<8> {
         let points: [Vec3; 5] = core::array::from_fn(|i| Vec3::new(0.0, -0.01 * i as f32, 0.0));
         Strand::from_polyline(&points, &Material::HUMAN_HAIR).unwrap()
+    }
+
+    /// The rod's guard as its pipeline calls it.
+    fn check(
+        strand: &mut Strand<8>,
+        good: &StrandState<8>,
+        inextensible: bool,
+        index: u32,
+        report: &mut StepReport,
+    ) -> bool {
+        guard(strand, good, |s, _| sound(s, inextensible), index, report)
     }
 
     #[test]
@@ -104,6 +104,7 @@ mod tests {
         assert!(check(&mut strand, &good, true, 7, &mut report));
         assert_eq!(strand.state.position[3], good.position[3]);
         assert_eq!(report.rolled_back, 1);
+        assert_eq!(report.rolled_back_strands.as_slice(), &[7]);
     }
 
     #[test]

@@ -9,6 +9,15 @@
 //! Every `f32` goes in as the little-endian bytes of its bit pattern, so `-0.0` and `0.0`
 //! differ. The guard never lets a NaN into the state, so NaN payloads (which differ between
 //! x86 and ARM) never reach the hash.
+//!
+//! Neither the rest data nor a strand's [`Schedule`](crate::strand::Schedule) is hashed. Rest
+//! data never changes once a strand is built. The schedule (whether the rod takes the implicit
+//! bending step from now on) is a decision the steps derive from the states they passed
+//! through, so it adds nothing a comparison of states would not see a step later: two runs
+//! whose schedules part ways also part ways in their states. What the hash pins is the
+//! physical state, the one thing host and firmware, a recording and its replay, and the
+//! golden tables compare; a decision about how to compute the next step is not part of it
+//! (and hashing it would change every pinned hash for no new information).
 
 use crate::math::{Real, Vec3};
 use crate::strand::Strand;

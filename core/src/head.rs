@@ -63,7 +63,7 @@ impl defmt::Format for Pose {
 
 /// Rotation about an axis through `centre`, `angle(t) = amplitude · sin(2π f t)`.
 ///
-/// DESIGN.md's "shaking at 10 rad/s" is `Shake::TEN_RAD_PER_S`: about the vertical axis,
+/// Kmoch 2009's "shaking at 10 rad/s" is `Shake::TEN_RAD_PER_S`: about the vertical axis,
 /// amplitude 0.5 rad, peak angular speed `2π f · 0.5 = 10 rad/s` (f ≈ 3.18 Hz).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Shake {

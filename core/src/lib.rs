@@ -6,8 +6,8 @@
 //! preservation of Sánchez-Banderas et al. 2015.
 //!
 //! * [`world::World`] — fixed-capacity strands, colliders and grabs; `step()` each tick.
-//! * [`world::step_strands`] — the same step on any slice of strands (the std harness splits
-//!   strand blocks over threads with it).
+//! * [`pipeline::step_strands`] — the same step on any slice of strands (the std harness
+//!   splits strand blocks over threads with it); [`pipeline`] reads like the papers' Algorithm 1.
 //! * [`strand::Strand`] — rest data apart from state; only state is hashed and rolled back.
 //! * [`effects::Effects`] — what a scene turns on; a stage that is off is never computed.
 //! * [`report::StepReport`] — what a step did: stages, iterations, flags, forces.
@@ -19,12 +19,9 @@
 #![no_std]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
+#![deny(clippy::too_many_lines, clippy::too_many_arguments)]
 
-// Unit tests print the figures they measure and use std's float functions; the library never
-// links std.
-#[cfg(test)]
-extern crate std; // cfg(test) only
-
+pub mod capacities;
 pub mod collide;
 pub mod context;
 pub mod dftl;
@@ -37,24 +34,37 @@ pub mod grab;
 pub mod guard;
 pub mod hash;
 pub mod head;
+pub mod lane;
 pub mod math;
 pub mod params;
+pub mod pipeline;
 pub mod precision;
 pub mod projection;
 pub mod report;
+pub mod rest;
 pub mod rod;
+pub mod root_coupling;
 pub mod scenes;
+pub mod snapshot;
 pub mod strand;
+pub mod wind;
 pub mod world;
 
 pub use collide::{Collider, Shape};
-pub use effects::{Effect, Effects};
+pub use effects::{Effect, Effects, Solver};
 pub use error::{BuildError, CapacityError, Error, ParamError};
 pub use grab::{Grab, GrabStatus};
 pub use head::{Pose, Shake};
 pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
-pub use params::{DftlCoefficients, DftlParams, Mode, Params, Solver, WindParams};
+pub use params::{DftlCoefficients, DftlParams, Mode, Params, WindParams};
+pub use pipeline::dftl::step_blocks;
+pub use pipeline::step_strands;
 pub use projection::project_constraints;
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};
-pub use world::{step_strands, StepInput, World};
+pub use world::{StepInput, World};
+
+// Unit tests print the figures they measure and use std's float functions; the library never
+// links std.
+#[cfg(test)]
+extern crate std; // cfg(test) only

@@ -112,6 +112,13 @@ pub fn is_finite(v: Vec3) -> bool {
     v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
 }
 
+/// `v / |v|` as `v · (1/|v|)`, with the backend's square root.
+#[inline]
+#[must_use]
+pub fn unit<M: Math>(v: Vec3) -> Vec3 {
+    v * (1.0 / M::length(v))
+}
+
 /// Rotates `v` by the unit quaternion `q` with scalar code written out here, so the order of
 /// every sum is fixed on every target (glam's SSE2 quaternion code sums in another order).
 #[inline(always)]
@@ -178,7 +185,7 @@ pub fn quat_between_unnormalized(a: Vec3, b: Vec3) -> Quat {
 /// `s = 1/(1 + α̃)`): `α = Δt_ref² (1 − s_ref)/s_ref` and `s(Δt) = Δt²/(Δt² + α)`, which gives
 /// `s_ref` back at `Δt_ref`.
 ///
-/// This departs from DESIGN.md's `1 − (1 − s_ref)^{Δt/Δt_ref}`, which keeps the relaxation
+/// This departs from the rule `1 − (1 − s_ref)^{Δt/Δt_ref}`, which keeps the relaxation
 /// time instead: its `s` shrinks only like `Δt`, so the spring stiffens like `1/Δt`, and the
 /// one-sided local constraint (node `i + 1` pulled into node `i`'s frame, no reaction) then
 /// flutters as `Δt` shrinks — 78 m/s at Δt = 10 µs, 13 m/s at 0.1 ms on a shaking head

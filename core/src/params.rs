@@ -1,39 +1,27 @@
 //! A world's parameters, fixed when the world is built (the time step included).
 
+pub use crate::effects::Solver;
 use crate::effects::{Effect, Effects};
 use crate::error::ParamError;
 use crate::math::{Real, Vec3};
-pub use crate::rod::twist::TwistMethod;
 
-/// Which model steps the strands.
+/// Which quasistatic twist a scene uses.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Solver {
-    /// Discrete Kirchhoff rods with fast manifold projection (Kmoch et al. 2009).
-    Rod,
-    /// Dynamic Follow-The-Leader with shape preservation (Sánchez-Banderas et al. 2015).
-    Dftl,
+pub enum TwistMethod {
+    /// Kmoch 2009 Sec. 6.2: material frames follow the curvature binormals.
+    HairOptimised,
+    /// BWR08: Newton's method on the tridiagonal twist Hessian.
+    Newton,
 }
 
-impl Solver {
-    /// The solver's name in scene files and reports (`"rod"`, `"dftl"`).
+impl TwistMethod {
+    /// The method's name in scene files (`"hair-optimised"`, `"newton"`).
     #[must_use]
     pub const fn name(self) -> &'static str {
         match self {
-            Solver::Rod => "rod",
-            Solver::Dftl => "dftl",
-        }
-    }
-
-    /// Whether this solver can simulate `effect`: bending and twist need the rod's energies,
-    /// shape preservation is DFTL's.
-    #[must_use]
-    pub const fn supports(self, effect: Effect) -> bool {
-        match self {
-            Solver::Rod => !matches!(effect, Effect::Shape),
-            // DFTL has no grab constraint (its single root-to-tip pass cannot hold a middle
-            // node): refused, not silently ignored.
-            Solver::Dftl => !matches!(effect, Effect::Bending | Effect::Twist | Effect::Grabs),
+            TwistMethod::HairOptimised => "hair-optimised",
+            TwistMethod::Newton => "newton",
         }
     }
 }
@@ -104,7 +92,7 @@ impl DftlParams {
     /// The per-step fractions at the step `dt`, computed once at set-up (`World::configure`),
     /// never per step: `s(Δt) = Δt²/(Δt² + α)` with `α = Δt_ref²(1 − s_ref)/s_ref`, the same
     /// spring at every step ([`crate::math::relaxation_at_step`] says why, and where this
-    /// departs from DESIGN.md).
+    /// departs from the paper's rule, `docs/design-departures.md`).
     /// `s_d` is a fraction of the correction fed back and is not rescaled.
     #[must_use]
     pub fn at_step(&self, dt: Real) -> DftlCoefficients {
@@ -136,7 +124,7 @@ pub struct DftlCoefficients {
 
 /// Wind, an external acceleration on every free node of both solvers (used when `wind` is on):
 /// `a(t) = direction · strength · (1 + gust · n(t))`, with `n` a seeded, smooth value noise of
-/// time in `[−1, 1]` (see `forces::wind_acceleration`).
+/// time in `[−1, 1]` (see `wind::wind_acceleration`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WindParams {
     /// Unit direction the wind blows towards (world frame). Default +x.
@@ -196,6 +184,15 @@ pub const MAX_DT: Real = 0.02;
 pub const ROD_MAX_DT: Real = 0.004;
 /// Smallest time step any scene may use, s.
 pub const MIN_DT: Real = 1.0e-5;
+/// `Ok` if `ok`, else the out-of-range error naming `field` and what is `allowed`.
+fn range(ok: bool, field: &'static str, allowed: &'static str) -> Result<(), ParamError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(ParamError::OutOfRange { field, allowed })
+    }
+}
+
 /// The least `s_d` DFTL accepts with the local shape constraint on ([`Params::validate`]).
 pub const MIN_SHAPE_DAMPING: Real = 0.5;
 
@@ -218,7 +215,7 @@ impl Params {
         dftl: DftlParams {
             damping: 0.9,
             // The paper's s_g = 0.1, s_l = 0.3 at 16 ms carried to 1 ms by its relaxation
-            // time, `1 − (1 − s)^{1/16}` (DESIGN.md), and held as springs from there.
+            // time, `1 − (1 − s)^{1/16}`, and held as springs from there.
             global_shape: 0.0066,
             local_shape: 0.022,
             reference_dt: 0.001,
@@ -234,38 +231,24 @@ impl Params {
         },
     };
 
-    /// Checks that `strand` can be stepped stably with these parameters: with the rod solver and
-    /// bending on, the fixed substep count that keeps explicit bending within its stability
-    /// bound ([`crate::rod::step::needed_substeps`]) must fit [`crate::rod::step::MAX_SUBSTEPS`].
-    /// Stiffer hair, shorter segments or a larger `µ` lower the limit like
-    /// `h² / √(max(1, µ)·α)`; such a strand with too large a `dt` is refused here rather than
-    /// left to chatter or explode.
-    pub fn validate_strand<const N: usize>(
-        &self,
-        strand: &crate::strand::Strand<N>,
-    ) -> Result<(), ParamError> {
-        let bending = self.solver == Solver::Rod && self.effects.contains(Effect::Bending);
-        match crate::rod::step::needed_substeps(&strand.rest.rod, self.dt, bending) {
-            Some(_) => Ok(()),
-            None => Err(ParamError::OutOfRange {
-                field: "dt",
-                allowed: "at most 128 substeps' worth of the strand's explicit bending limit: \
-                          dt <= 128 * 0.7 * dt_max / 4 with dt_max = (h^2/2) * sqrt(rho*A / \
-                          (max(1, mu) * E*pi*r^4/4)) for the shortest segment h; use a smaller \
-                          dt, longer segments or softer hair",
-            }),
+    /// Checks every parameter against its range and the effects against the solver (the
+    /// first failure, in this order: time step, forces, rod, DFTL, wind, effects).
+    pub fn validate(&self) -> Result<(), ParamError> {
+        self.validate_time_step_and_forces()?;
+        self.validate_rod()?;
+        self.validate_dftl()?;
+        self.validate_wind()?;
+        if let Some(effect) = self.effects.unsupported_by(self.solver) {
+            return Err(ParamError::UnsupportedEffect {
+                effect: effect.name(),
+                solver: self.solver.name(),
+            });
         }
+        Ok(())
     }
 
-    /// Checks every parameter against its range and the effects against the solver.
-    pub fn validate(&self) -> Result<(), ParamError> {
-        let range = |ok: bool, field, allowed| {
-            if ok {
-                Ok(())
-            } else {
-                Err(ParamError::OutOfRange { field, allowed })
-            }
-        };
+    /// The time step (for the solver) and the scene's gravity and drag.
+    fn validate_time_step_and_forces(&self) -> Result<(), ParamError> {
         range(
             self.dt.is_finite() && (MIN_DT..=MAX_DT).contains(&self.dt),
             "dt",
@@ -288,6 +271,11 @@ impl Params {
             "drag",
             "a finite value >= 0 kg/s",
         )?;
+        Ok(())
+    }
+
+    /// The rod's iteration caps and tolerances.
+    fn validate_rod(&self) -> Result<(), ParamError> {
         range(
             self.rod.projection_iterations >= 1 && self.rod.projection_iterations <= 1000,
             "rod.projection_iterations",
@@ -308,6 +296,11 @@ impl Params {
             "rod.newton_tolerance",
             "a finite value > 0 rad",
         )?;
+        Ok(())
+    }
+
+    /// DFTL's fractions, reference step and fades.
+    fn validate_dftl(&self) -> Result<(), ParamError> {
         let fraction = |v: Real| v.is_finite() && (0.0..=1.0).contains(&v);
         range(fraction(self.dftl.damping), "dftl.damping", "0 to 1")?;
         range(
@@ -346,6 +339,11 @@ impl Params {
             "dftl.local_shape_fade",
             "0 to 1",
         )?;
+        Ok(())
+    }
+
+    /// The wind.
+    fn validate_wind(&self) -> Result<(), ParamError> {
         let wind = &self.wind;
         range(
             crate::math::is_finite(wind.direction)
@@ -368,12 +366,6 @@ impl Params {
             "wind.gust_frequency",
             "0 to 1000 Hz",
         )?;
-        if let Some(effect) = self.effects.unsupported_by(self.solver) {
-            return Err(ParamError::UnsupportedEffect {
-                effect: effect.name(),
-                solver: self.solver.name(),
-            });
-        }
         Ok(())
     }
 }

@@ -1,63 +1,67 @@
 //! The step report: what a step did, instead of failing. Stage counters, iterations and
 //! residuals, flags, high-water marks, and the forces a haptic device renders.
 
-use crate::collide::MAX_COLLIDERS;
-use crate::grab::MAX_GRABS;
+use crate::capacities::{MAX_COLLIDERS, MAX_GRABS};
 use crate::math::{Real, Vec3};
 
-/// The stages of a step, in the order they run.
+/// The stages of a step, declared in the order they run: the rod's pipeline (Kmoch 2009
+/// Algorithm 1) and DFTL's (Sánchez-Banderas 2015 Algorithm 1) each run a subsequence of this
+/// list, in this order, on every strand (`pipeline::rod`, `pipeline::dftl`).
 ///
-/// 1. `Snapshot` — keep the strand's last good state (rollback).
-/// 2. `ExternalForces` — gravity, drag, caller accelerations (SPH, wind).
-/// 3. `ElasticForces` — bending and twist forces (rod, Kmoch Sec. 7.2).
-/// 4. `Twist` — quasistatic twist update (rod, Sec. 6.2 or Newton).
-/// 5. `Integrate` — symplectic Euler (rod) or prediction (DFTL).
-/// 6. `RootCoupling` — nodes 0 and 1 follow the head.
-/// 7. `Shape` — global and local shape constraints (DFTL).
-/// 8. `Projection` — inextensibility, grabs, collisions (rod: fast manifold projection;
-///    DFTL: follow-the-leader).
-/// 9. `Collisions` — contacts found and resolved.
-/// 10. `Velocity` — velocity update from the position change.
-/// 11. `Guard` — non-finite check, rollback.
+/// 0. `HairHair` — SPH hair–hair interaction (SB15 lines 1–11), in the std harness, once per
+///    step for all strands at once: its accelerations are an input of the strands' step.
+/// 1. `Snapshot` — keep the strand's last good state (quarantine).
+/// 2. `ElasticForces` — bending and twist forces (rod, Kmoch Sec. 7.2; Alg. 1 line 3).
+/// 3. `ExternalForces` — gravity, drag, wind, the caller's accelerations (rod line 3; DFTL
+///    line 13).
+/// 4. `Integrate` — symplectic Euler or the implicit bending step (rod line 4); DFTL's
+///    prediction `x* = x + vΔt + aΔt²` (line 14).
+/// 5. `RootCoupling` — nodes 0 and 1 follow the head (both solvers).
+/// 6. `Shape` — global and local shape constraints (DFTL line 18).
+/// 7. `Projection` — the rod's fast manifold projection (lines 5–7: inextensibility,
+///    collisions, grabs); DFTL's follow-the-leader inextensibility (line 19).
+/// 8. `Collisions` — contacts found and resolved (rod: inside the projection; DFTL line 20).
+/// 9. `Velocity` — velocities from the position change (rod line 8; DFTL lines 24–26).
+/// 10. `Twist` — the Bishop frame in space and the quasistatic twist (rod lines 9–10).
+/// 11. `Guard` — non-finite (or blown-up) strands rolled back (rod line 11; after DFTL's pass).
 ///
-/// `HairHair` is the harness's SPH stage (Sánchez-Banderas 2015 Algorithm 1, lines 1–11): it
-/// runs before all of these, outside the core, once per step for all strands at once; the
-/// harness counts it (for every strand it computed accelerations for) when it runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// DFTL fuses its lines 12–27 into one pass from the root, node by node; its stages are
+/// counted in the algorithm's order (the predictions of nodes 2 and on do not depend on the
+/// root coupling of nodes 0 and 1, so the order is the same computation).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[repr(u8)]
 pub enum Stage {
+    /// Hair–hair interaction (SPH, in the harness), before the strands' own stages.
+    HairHair = 0,
     /// Keep the last good state.
-    Snapshot = 0,
-    /// Gravity, drag, caller accelerations.
-    ExternalForces = 1,
+    Snapshot = 1,
     /// Bending and twist forces.
     ElasticForces = 2,
-    /// Quasistatic twist.
-    Twist = 3,
-    /// Symplectic Euler / prediction.
+    /// Gravity, drag, wind, caller accelerations.
+    ExternalForces = 3,
+    /// Symplectic Euler, implicit bending step, or DFTL's prediction.
     Integrate = 4,
     /// Roots follow the head.
     RootCoupling = 5,
     /// DFTL shape constraints.
     Shape = 6,
-    /// Inextensibility projection.
+    /// Inextensibility: fast manifold projection (rod) or follow-the-leader (DFTL).
     Projection = 7,
     /// Collision handling.
     Collisions = 8,
     /// Velocity update.
     Velocity = 9,
+    /// Bishop frame and quasistatic twist.
+    Twist = 10,
     /// Non-finite check and rollback.
-    Guard = 10,
-    /// Hair–hair interaction (SPH, in the harness), before the strands' own stages.
-    HairHair = 11,
+    Guard = 11,
 }
 
 /// Number of [`Stage`]s.
 pub const STAGE_COUNT: usize = 12;
 
-/// Most strand indices a report names individually (the count is always exact).
-pub const NAMED_STRANDS: usize = 8;
+pub use crate::capacities::NAMED_STRANDS;
 
 /// Flags raised by a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -136,6 +140,32 @@ pub struct StepReport {
     pub grabs_slipped: u8,
     /// Total contact force the hair exerts on each collider, N (from the collision multipliers).
     pub collider_forces: [Vec3; MAX_COLLIDERS],
+    /// Every stage this step counted ([`StepReport::ran_on`]), in call order: recorded in the
+    /// core's unit tests only, where `pipeline::tests` checks that the pipelines run the
+    /// stages in [`Stage`]'s order. In the library it is empty and records nothing: a step
+    /// pays nothing for it.
+    pub trace: StageTrace,
+}
+
+/// The library's stage trace: nothing (zero-sized; [`StageTrace::push`] does nothing). The
+/// core's unit tests record the stages instead.
+#[cfg(not(test))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StageTrace;
+
+#[cfg(not(test))]
+impl StageTrace {
+    /// The empty trace.
+    #[must_use]
+    pub const fn new() -> Self {
+        StageTrace
+    }
+
+    /// Records nothing.
+    #[inline(always)]
+    pub fn push(&mut self, _: Stage) -> Result<(), Stage> {
+        Ok(())
+    }
 }
 
 impl Default for StepReport {
@@ -157,6 +187,7 @@ impl Default for StepReport {
             grab_forces: [Vec3::ZERO; MAX_GRABS],
             grabs_slipped: 0,
             collider_forces: [Vec3::ZERO; MAX_COLLIDERS],
+            trace: StageTrace::new(),
         }
     }
 }
@@ -185,7 +216,16 @@ impl StepReport {
     /// Counts one strand through `stage`.
     #[inline(always)]
     pub fn ran(&mut self, stage: Stage) {
-        self.stage_runs[stage as usize] += 1;
+        self.ran_on(stage, 1);
+    }
+
+    /// Counts `strands` strands through `stage` (a block's lanes at once).
+    #[inline(always)]
+    pub fn ran_on(&mut self, stage: Stage, strands: u32) {
+        self.stage_runs[stage as usize] += strands;
+        // (In the unit tests, a full trace fails the tests that read it: they check its
+        // length.)
+        let _ = self.trace.push(stage);
     }
 
     /// How many strands `stage` ran on.
@@ -232,3 +272,12 @@ impl StepReport {
         }
     }
 }
+
+/// The unit tests' stage trace: every stage counted, in call order, up to
+/// [`TRACE_CAPACITY`].
+#[cfg(test)]
+pub type StageTrace = heapless::Vec<Stage, TRACE_CAPACITY>;
+
+/// Entries of the unit tests' [`StageTrace`].
+#[cfg(test)]
+pub const TRACE_CAPACITY: usize = 256;

@@ -1,5 +1,6 @@
 //! A strand: its rest data (never changes once built) apart from its state (what a step
-//! changes, and the only thing hashed, snapshotted and rolled back).
+//! changes, and the only thing hashed, snapshotted and rolled back), and the schedule a step
+//! keeps for it (which integrator it takes from now on).
 //!
 //! Nodes `x_0 … x_{n+1}`, segments `e^j = x_{j+1} − x_j` for `j = 0 … n` (Kmoch 2009, Sec. 4).
 //! Nodes 0 and 1 are held by the head (root coupling), so a strand has at least 3 nodes.
@@ -7,10 +8,8 @@
 
 use crate::error::BuildError;
 use crate::math::{Libm, Math, Real, Vec3};
-use crate::rod::energy::{rest_root_frame, RodRest};
 
-/// Shortest rest segment a strand may have, m.
-pub const MIN_SEGMENT_LENGTH: Real = 1.0e-6;
+pub use crate::capacities::MIN_SEGMENT_LENGTH;
 
 /// A round hair fibre's material (SI units).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -98,9 +97,8 @@ impl Material {
 
 /// What a strand is at rest; computed once when the strand is built.
 #[derive(Clone, Debug, PartialEq)]
+#[repr(C)]
 pub struct RestStrand<const N: usize> {
-    /// Number of nodes `n + 2` (≥ 3, ≤ N).
-    pub nodes: usize,
     /// Rest positions `x̂_i` in the head's frame.
     pub position: [Vec3; N],
     /// Rest segment lengths `|ê^j|`, `j = 0 … nodes − 2`.
@@ -109,20 +107,76 @@ pub struct RestStrand<const N: usize> {
     pub mass: [Real; N],
     /// `1 / mass`.
     pub inverse_mass: [Real; N],
-    /// Bending stiffness `α^j` per segment, N·m² (may vary along the strand).
-    pub bending_stiffness: [Real; N],
-    /// `µ`, the minor-axis multiplier: `B^j = diag(µ α^j, α^j)`.
-    pub minor_axis_penalty: Real,
-    /// Twist stiffness `β`, N·m².
-    pub twist_stiffness: Real,
     /// DFTL's rest frames and local rest vectors (Sánchez-Banderas 2015 Sec. 3.1).
-    pub dftl: crate::dftl::DftlRest<N>,
-    /// The rod energies' rest data (`l̂`, `ω̂`, `m̂`, `θ̂`, the stable time step).
+    pub dftl: DftlRest<N>,
+    /// Number of nodes `n + 2` (≥ 3, ≤ N).
+    pub nodes: usize,
+    /// The rod energies' rest data (`l̂`, `ω̂`, `m̂`, `θ̂`, the stiffnesses, the stable time
+    /// step).
     pub rod: RodRest<N>,
+}
+
+/// Rest data of the rod energies, computed once when a strand is built
+/// ([`RodRest::compute`]): with these, the strand's rest polyline — straight, wavy or helical —
+/// has zero elastic energy and zero elastic force under both twist methods.
+///
+/// Index conventions: per segment `j = 0 … n` (`rest_length`, `bending_stiffness`,
+/// `rest_theta`), per interior node `i = 1 … n` (`voronoi_length`, `rest_twist`,
+/// `rest_curvature`); unused slots are zero.
+#[derive(Clone, Debug, PartialEq)]
+#[repr(C)]
+pub struct RodRest<const N: usize, R = Real> {
+    /// Rest segment lengths `|ê^j|`, m.
+    pub rest_length: [R; N],
+    /// `l̂_i = |ê^{i−1}| + |ê^i|`, m (twice the node's Voronoi length).
+    pub voronoi_length: [R; N],
+    /// `1 / l̂_i` (zero where `l̂_i` is unused): the kernels multiply instead of dividing.
+    pub inverse_voronoi_length: [R; N],
+    /// Bending stiffness `α^j` per segment, N·m².
+    pub bending_stiffness: [R; N],
+    /// `µ`: `B^j = diag(µ α^j, α^j)`.
+    pub minor_axis_penalty: R,
+    /// Twist stiffness `β`, N·m².
+    pub twist_stiffness: R,
+    /// Rest material angles `θ̂^j`: the hair-optimised twist of the rest shape with `θ̂^0 = 0`
+    /// (the material frame follows the binormals, as the twist solver will put it).
+    pub rest_theta: [R; N],
+    /// Rest twist `m̂_i = θ̂^i − θ̂^{i−1}`, rad.
+    pub rest_twist: [R; N],
+    /// `(cos m̂_i, sin m̂_i)`: the hair-optimised twist continues a segment's frame by this
+    /// rotation without calling `sin`/`cos` per node.
+    pub rest_twist_rotation: [[R; 2]; N],
+    /// Rest material curvatures `[ω̂^{i−1}_i, ω̂^i_i]` per node.
+    pub rest_curvature: [[[R; 2]; 2]; N],
+    /// Largest stable explicit time step of the bending forces,
+    /// `(h²/2)·√(ρA / (max(1, µ) α))` with `h` the shortest segment (docs/architecture.md,
+    /// "Stability of explicit bending"); infinite without bending stiffness.
+    pub stable_time_step: R,
+}
+
+/// What DFTL's shape constraints need of a strand at rest (in the head's frame).
+#[derive(Clone, Debug, PartialEq)]
+#[repr(C)]
+pub struct DftlRest<const N: usize> {
+    /// `t̂_0 = R̂_0 e_x`: the first rest segment's direction.
+    pub root_tangent: Vec3,
+    /// `n̂_0 = R̂_0 e_y`, `R̂_0` the minimal rotation from `e_x` to `t̂_0`.
+    pub root_normal: Vec3,
+    /// `r_i = R̂_{i−1}⁻¹ (x̂_i − x̂_{i−1})`: node `i`'s rest offset in the frame of node `i − 1`,
+    /// as components along `(t̂_{i−1}, n̂_{i−1}, t̂_{i−1} × n̂_{i−1})` (entries 0 and 1 unused:
+    /// those nodes are held by the head).
+    pub local_rest: [Vec3; N],
+    /// `d_i / L`: rest distance from the root along the strand over the strand's length, 0 at
+    /// the root and 1 at the tip (for coefficients that fade with distance from the root).
+    pub root_distance: [Real; N],
+    /// `1 / (2 l_{i−1}²)` for the segment ending at node `i` (0 for `i = 0`): the step measures
+    /// the strain `(|e|² − l²)/(2 l²)` without a square root or a division.
+    pub strain_scale: [Real; N],
 }
 
 /// What a step changes. Only this is hashed, snapshotted and rolled back.
 #[derive(Clone, Debug, PartialEq)]
+#[repr(C)]
 pub struct StrandState<const N: usize> {
     /// Node positions `x_i`, m (world frame).
     pub position: [Vec3; N],
@@ -134,94 +188,38 @@ pub struct StrandState<const N: usize> {
     pub root_frame: Vec3,
 }
 
-/// One strand: rest data and state.
+/// What the steps decided for a strand so far, which later steps follow: kept apart from the
+/// rest data (which never changes once built) and from the state (which a roll-back restores,
+/// and the state hash covers; `crate::hash` says why this is not hashed).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Schedule {
+    /// Set when the strand's shape was folded sharper than its explicit substeps can hold, or
+    /// when it diverged and was rolled back: from then on the rod steps its bending with the
+    /// linearly implicit step whatever its substep count (`rod::implicit`). Such states — a
+    /// fold near a hairpin, nodes pushed out of a collider — are ones the implicit step holds
+    /// (tests/torture.rs); the step's cost stays bounded by the implicit step's. Kept across
+    /// roll-backs: a roll-back is what sets it.
+    pub implicit_bending: bool,
+}
+
+/// One strand: rest data, state and schedule.
+///
+/// `repr(C)`, as the other strand data: the declared order is the layout. The step's loads
+/// reach fields by an immediate offset from the strand, which on the Cortex-M4F is short
+/// (±1020 bytes for `VLDR`): the state first, then the rest data in the order of its
+/// declaration, keeps the fields a step reads most within it.
 #[derive(Clone, Debug, PartialEq)]
+#[repr(C)]
 pub struct Strand<const N: usize> {
-    /// Rest data: never changed by a step.
-    pub rest: RestStrand<N>,
     /// State: positions, velocities, twist, root frame.
     pub state: StrandState<N>,
+    /// Rest data: never changed by a step.
+    pub rest: RestStrand<N>,
+    /// What earlier steps decided for this strand.
+    pub schedule: Schedule,
 }
 
 impl<const N: usize> Strand<N> {
-    const CAPACITY_OK: () = assert!(N >= 3, "a strand needs a capacity of at least 3 nodes");
-
-    /// Builds a strand at rest from its rest polyline (root first, in the head's frame) and a
-    /// material. Checks the node count against `N`, every coordinate, every segment's length
-    /// and the material's ranges.
-    pub fn from_polyline(points: &[Vec3], material: &Material) -> Result<Self, BuildError> {
-        #[allow(clippy::let_unit_value)]
-        let () = Self::CAPACITY_OK;
-        let nodes = points.len();
-        if nodes < 3 {
-            return Err(BuildError::TooFewNodes { count: nodes });
-        }
-        if nodes > N {
-            return Err(BuildError::TooManyNodes {
-                count: nodes,
-                capacity: N,
-            });
-        }
-        material.validate()?;
-        if let Some(node) = points.iter().position(|p| !crate::math::is_finite(*p)) {
-            return Err(BuildError::NonFiniteNode { node });
-        }
-        let mut rest = RestStrand {
-            nodes,
-            position: [Vec3::ZERO; N],
-            segment_length: [0.0; N],
-            mass: [0.0; N],
-            inverse_mass: [0.0; N],
-            bending_stiffness: [0.0; N],
-            minor_axis_penalty: material.minor_axis_penalty,
-            twist_stiffness: material.twist_stiffness(),
-            dftl: crate::dftl::DftlRest::from_polyline::<Libm>(&[]),
-            rod: RodRest::compute::<Libm>(&[], 0.0, 1.0, 0.0, 1.0),
-        };
-        rest.position[..nodes].copy_from_slice(points);
-        let lambda = material.linear_density();
-        let alpha = material.bending_stiffness();
-        for j in 0..nodes - 1 {
-            let e = points[j + 1] - points[j];
-            let length = Libm::length(e);
-            if !length.is_finite() || length < MIN_SEGMENT_LENGTH {
-                return Err(BuildError::DegenerateSegment { segment: j });
-            }
-            if j > 0 {
-                let previous = points[j] - points[j - 1];
-                // Turning angle of π: the curvature binormal 2(e×e')/(|e||e'| + e·e') divides by 0.
-                if previous.dot(e) <= -0.999_999 * rest.segment_length[j - 1] * length {
-                    return Err(BuildError::FoldedSegment { node: j });
-                }
-            }
-            rest.segment_length[j] = length;
-            rest.bending_stiffness[j] = alpha;
-            rest.mass[j] += 0.5 * lambda * length;
-            rest.mass[j + 1] += 0.5 * lambda * length;
-        }
-        for i in 0..nodes {
-            rest.inverse_mass[i] = 1.0 / rest.mass[i];
-        }
-        rest.dftl = crate::dftl::DftlRest::from_polyline::<Libm>(points);
-        // Segments are checked above: the rod's rest data divides by their lengths.
-        rest.rod = RodRest::compute::<Libm>(
-            points,
-            alpha,
-            material.minor_axis_penalty,
-            material.twist_stiffness(),
-            lambda,
-        );
-        let mut state = StrandState {
-            position: [Vec3::ZERO; N],
-            velocity: [Vec3::ZERO; N],
-            // The rest material frames: a strand starts at rest for the twist solvers too.
-            theta: rest.rod.rest_theta,
-            root_frame: rest_root_frame::<Libm>(points[0], points[1], rest.segment_length[0]),
-        };
-        state.position[..nodes].copy_from_slice(points);
-        Ok(Strand { rest, state })
-    }
-
     /// Number of nodes of this strand.
     #[must_use]
     pub fn nodes(&self) -> usize {
@@ -259,7 +257,10 @@ impl<const N: usize> Strand<N> {
     }
 }
 
-/// A unit vector perpendicular to `t` (deterministic: crossed with the axis least aligned).
+/// A unit vector perpendicular to `t` (deterministic: crossed with the axis least aligned),
+/// normalised by dividing by its length, in `f32`: how scenes pick a strand's sideways
+/// direction. (The rod's frames normalise by the reciprocal instead,
+/// `frames::perpendicular_unit_by_reciprocal`: other bits.)
 #[must_use]
 pub fn perpendicular_unit(t: Vec3) -> Vec3 {
     let a = t.abs();

@@ -1,20 +1,18 @@
-//! The world and the step pipeline.
-//!
-//! [`step_strands`] is the whole step for a block of strands; it reads top to bottom like the
-//! papers' Algorithm 1, one line per stage, each gated by the scene's effects inside the
-//! solver. [`World`] is the fixed-capacity convenience around it that firmware keeps in a
-//! `static`; the std harness calls [`step_strands`] on strand blocks of its own `Vec`.
+//! The world: the fixed-capacity convenience around the step pipeline
+//! ([`crate::pipeline`]) that firmware keeps in a `static`. The std harness runs the same
+//! pipeline on strand blocks of its own `Vec`.
 
 use core::marker::PhantomData;
 
-use crate::collide::{Collider, MAX_COLLIDERS};
-use crate::context::StepContext;
+use crate::capacities::{MAX_COLLIDERS, MAX_GRABS};
+use crate::collide::Collider;
 use crate::error::{CapacityError, Error, ParamError};
-use crate::grab::{Grab, GrabStatus, MAX_GRABS};
+use crate::grab::{retarget, Grab, GrabStatus};
 use crate::head::Pose;
-use crate::math::{DefaultMath, Math, Real, Vec3};
-use crate::params::{DftlCoefficients, Params, Solver};
-use crate::report::{Flags, Stage, StepReport};
+use crate::math::{DefaultMath, Math, Vec3};
+use crate::params::{DftlCoefficients, Params};
+use crate::pipeline::{begin, finish, step_strands, Inputs, Stepping};
+use crate::report::StepReport;
 use crate::strand::Strand;
 
 /// What the caller hands in each tick.
@@ -25,53 +23,6 @@ pub struct StepInput<'a> {
     /// Optional per-node accelerations (SPH, wind from outside), m/s²: node `i` of strand `s`
     /// at `s * N + i`. Shorter slices leave the remaining strands without.
     pub accelerations: Option<&'a [Vec3]>,
-}
-
-/// Steps a block of strands by one `ctx.dt`. `first_strand` is the index of `strands[0]` in
-/// the whole scene (for grabs and the report); `accelerations`, if any, holds `N` entries per
-/// strand of this block. Never panics; a strand that turns non-finite is rolled back.
-pub fn step_strands<M: Math, const N: usize>(
-    ctx: &StepContext,
-    strands: &mut [Strand<N>],
-    first_strand: u32,
-    grabs: &[Grab],
-    accelerations: Option<&[Vec3]>,
-    report: &mut StepReport,
-) {
-    // What a DFTL step derives from the context (the head's rotation matrix among it) is the
-    // same for every strand: once per block.
-    let dftl_setup = match ctx.params.solver {
-        Solver::Rod => None,
-        Solver::Dftl => Some(crate::dftl::Setup::new(ctx)),
-    };
-    for (k, strand) in strands.iter_mut().enumerate() {
-        let index = first_strand + k as u32;
-        let strand_accelerations = accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
-        // 1. Keep the last good state (quarantine), 2. the solver's own stage list (Kmoch
-        // Alg. 1 or Sánchez-Banderas Alg. 1), then 3. the guard: nothing non-finite leaves
-        // the step.
-        report.ran(Stage::Snapshot);
-        if let Some(setup) = &dftl_setup {
-            // DFTL writes positions and velocities only, and a roll-back zeroes the
-            // velocities: the positions are the last good state it needs to keep (less than
-            // half the state's bytes). It keeps every segment at length by construction, and
-            // watches what it writes: no second pass over the strand.
-            let last_good = strand.state.position;
-            let good = crate::dftl::step::<M, N>(strand, setup, ctx, strand_accelerations, report);
-            crate::guard::restore_positions_unless(good, strand, &last_good, index, report);
-            continue;
-        }
-        let last_good = strand.state.clone();
-        crate::rod::step::step::<M, N>(strand, ctx, grabs, index, strand_accelerations, report);
-        // The rod's projection can be outrun by a configuration past its stability limit, so
-        // the rod also checks reach.
-        let inextensible = ctx.has(crate::effects::Effect::Inextensibility);
-        // 4. A rod strand the explicit bending substeps lost takes the implicit step from now
-        // on (`RodRest::implicit_bending`).
-        if crate::guard::check(strand, &last_good, inextensible, index, report) {
-            strand.rest.rod.implicit_bending = true;
-        }
-    }
 }
 
 /// A fixed-capacity world: up to `S` strands of up to `N` nodes, stepped with the math
@@ -188,9 +139,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// Moves grab `grab`'s target (ignored for an unknown index or a non-finite target).
     pub fn set_grab_target(&mut self, grab: usize, target: Vec3) {
         if let Some(g) = self.grabs.get_mut(grab) {
-            if crate::math::is_finite(target) {
-                g.target = target;
-            }
+            retarget(g, target);
         }
     }
 
@@ -247,32 +196,32 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// back and named).
     pub fn step(&mut self, input: &StepInput<'_>) -> StepReport {
         let mut report = StepReport::default();
-        let head = if input.head.is_finite() {
-            input.head
-        } else {
-            report.flags.insert(Flags::BAD_INPUT);
-            self.head
+        let world = Stepping {
+            params: &self.params,
+            dftl: self.dftl,
+            colliders: &self.colliders,
+            grabs: &mut self.grabs,
+            strands: &self.strands,
+            head: self.head,
+            steps: self.steps,
         };
-        let time = (self.steps + 1) as Real * self.params.dt;
-        let ctx = StepContext::with_coefficients(
-            &self.params,
-            self.dftl,
-            self.head,
-            head,
-            &self.colliders,
-        )
-        .at_time(time);
-        crate::grab::slip_unreachable(&ctx, &mut self.grabs, &self.strands, 0, &mut report);
+        let inputs = Inputs {
+            head: input.head,
+            grab_targets: &[],
+            released: &[],
+        };
+        let ctx = begin(world, &inputs, &mut report);
+        let accelerations = input.accelerations;
         step_strands::<M, N>(
             &ctx,
             &mut self.strands,
             0,
             &self.grabs,
-            input.accelerations,
+            accelerations,
             &mut report,
         );
-        crate::grab::apply_slips(&mut self.grabs, &report);
-        self.head = head;
+        finish(&mut self.grabs, &report);
+        self.head = ctx.head;
         self.steps += 1;
         report
     }
@@ -283,6 +232,7 @@ mod tests {
     use super::*;
     use crate::effects::{Effect, Effects};
     use crate::math::{Libm, Real};
+    use crate::report::Flags;
     use crate::strand::Material;
 
     fn world() -> World<2, 8, Libm> {

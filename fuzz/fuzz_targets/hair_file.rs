@@ -3,7 +3,7 @@
 //! back).
 #![no_main]
 
-use hairsim::hairfile::{read_hair, read_tfx, ReadOptions};
+use hairsim_files::hairfile::{read_hair, read_tfx, ReadOptions};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|bytes: &[u8]| {

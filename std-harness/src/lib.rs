@@ -5,17 +5,19 @@
 //! [`sim`], [`summary`]), record and replay ([`record`]), the command line ([`cmd`]), SPH
 //! hair–hair interaction ([`sph`]), hair files in ([`hairfile`]) and out ([`export`]), and
 //! pictures ([`picture`]).
+//!
+//! The files without the solver ([`scene`], [`builtin`], [`hairfile`], [`hairscene`] and the
+//! writers and readers of [`export`]) are the crate `hairsim-files`, re-exported here at the
+//! same paths.
 
-pub mod builtin;
+pub use hairsim_files::{builtin, hairfile, hairscene, scene};
+
 pub mod cmd;
 pub mod export;
-pub mod hairfile;
-pub mod hairscene;
 pub mod output;
 pub mod picture;
 pub mod record;
 pub mod run;
-pub mod scene;
 pub mod sim;
 pub mod sph;
 pub mod study;

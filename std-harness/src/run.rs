@@ -1,5 +1,6 @@
 //! Running a scene: pick the strand capacity, step it (on threads), time every step,
 //! record or replay the inputs, and summarise.
+#![deny(clippy::too_many_lines, clippy::too_many_arguments)]
 
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -10,6 +11,7 @@ use hairsim_core::grab::GrabStatus;
 use hairsim_core::{DefaultMath, Math, StepReport};
 
 use crate::builtin;
+pub use crate::hairscene::HairFileOptions;
 use crate::output;
 use crate::record::{BuildIdentity, Checkpoint, RecordedInputs, Recording, CAPACITIES, VERSION};
 use crate::scene::{HairSpec, Prepared, Scene, SceneError};
@@ -25,15 +27,6 @@ pub struct Loaded {
     pub scene: Scene,
     /// The checked plan.
     pub prepared: Prepared,
-}
-
-/// Options for a hair file given as the scene (`hairsim run head.hair`).
-#[derive(Clone, Debug, Default)]
-pub struct HairFileOptions {
-    /// Factor from the file's units to metres.
-    pub scale: Option<f32>,
-    /// The file's up axis, `y` or `z`.
-    pub up: Option<String>,
 }
 
 /// Loads SCENE: a built-in name, a TOML scene file, or a `.hair`/`.tfx` hair file.
@@ -169,7 +162,7 @@ pub fn capacity_for(nodes: usize) -> Result<usize> {
         .ok_or_else(|| {
             anyhow!(
                 "a strand has {nodes} nodes, allowed at most {} in this build",
-                CAPACITIES[3]
+                CAPACITIES[CAPACITIES.len() - 1]
             )
         })
 }
@@ -247,10 +240,9 @@ pub fn replay(path: &Path, threads: usize) -> Result<Summary> {
 }
 
 fn dispatch(loaded: &Loaded, options: &RunOptions, inputs: &Inputs<'_>) -> Result<Summary> {
+    // One arm per entry of `CAPACITIES`.
     match capacity_for(loaded.prepared.max_nodes())? {
-        16 => run_n::<16, DefaultMath>(loaded, options, inputs),
         32 => run_n::<32, DefaultMath>(loaded, options, inputs),
-        64 => run_n::<64, DefaultMath>(loaded, options, inputs),
         _ => run_n::<128, DefaultMath>(loaded, options, inputs),
     }
 }
@@ -291,8 +283,9 @@ impl Progress {
         }
     }
 
-    fn finish(self) {
-        if let Some(bar) = self.bar {
+    /// Clears the bar (also before an error is printed).
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
     }
@@ -305,88 +298,180 @@ fn run_n<const N: usize, M: Math>(
 ) -> Result<Summary> {
     let prepared = &loaded.prepared;
     let mut sim = Sim::<N, M>::new(prepared, options.threads).map_err(|e| anyhow!("{e}"))?;
-    let steps = options.steps.unwrap_or(prepared.steps);
-    let every = options.every;
-    let mut recording = options.record.as_ref().map(|_| Recording {
-        version: VERSION,
-        build: BuildIdentity::current::<M>(),
-        source: loaded.source.clone(),
-        scene: loaded.scene.to_toml(),
-        capacity: N,
-        every: every.unwrap_or(10),
-        inputs: Vec::with_capacity(steps.min(1 << 20) as usize),
-        checkpoints: Vec::new(),
-    });
-    let mut frames = match &options.out {
-        Some(dir) => Some(output::Frames::new(dir, prepared, every, steps)?),
-        None => None,
-    };
-    let mut totals = Totals::default();
-    // The median step time from at most ~100,000 evenly spread steps: bounded memory on long runs.
-    let stride = (steps / 100_000).max(1);
-    let mut times = Vec::with_capacity((steps / stride + 1) as usize);
-    let mut last = StepReport::default();
-    let mut progress = Progress::new(options.progress, steps);
-    let mut replayed = match inputs {
-        Inputs::Replay(r) => Some((r, r.checkpoints.iter().peekable())),
-        Inputs::Scene => None,
-    };
-    for k in 0..steps {
-        let step_inputs: StepInputs = match &replayed {
-            Some((r, _)) => r.inputs[k as usize].to_inputs(),
-            None => scene_inputs::<M>(prepared, k),
+    let mut runner = Runner::new::<M>(loaded, options, inputs, N)?;
+    for k in 0..runner.steps {
+        let step_inputs: StepInputs = match inputs {
+            Inputs::Replay(r) => r.inputs[k as usize].to_inputs(),
+            Inputs::Scene => scene_inputs::<M>(prepared, k),
         };
         let start = Instant::now();
-        last = sim.step(&step_inputs);
-        if k % stride == 0 {
-            times.push(start.elapsed().as_secs_f64());
+        let report = sim.step(&step_inputs);
+        runner.after_step(&sim, &step_inputs, k, start, report)?;
+    }
+    let outcome = runner.finish(&sim, options)?;
+    Ok(summary(loaded, options, &sim, outcome))
+}
+
+/// A run's bookkeeping around the simulation: step times and totals, the recording it
+/// writes, the recording it replays and checks, the frames and the progress bar.
+struct Runner<'a> {
+    steps: u64,
+    totals: Totals,
+    /// The last step's report.
+    last: StepReport,
+    /// Every `stride`-th step's time, s.
+    times: Vec<f64>,
+    stride: u64,
+    recording: Option<Recording>,
+    replayed: Option<std::iter::Peekable<std::slice::Iter<'a, Checkpoint>>>,
+    frames: Option<output::Frames>,
+    progress: Progress,
+}
+
+/// What a finished run leaves for its summary.
+struct Outcome {
+    steps: u64,
+    totals: Totals,
+    last: StepReport,
+    times: Vec<f64>,
+    written: Vec<PathBuf>,
+}
+
+impl<'a> Runner<'a> {
+    fn new<M: Math>(
+        loaded: &Loaded,
+        options: &RunOptions,
+        inputs: &Inputs<'a>,
+        capacity: usize,
+    ) -> Result<Runner<'a>> {
+        let steps = options.steps.unwrap_or(loaded.prepared.steps);
+        let every = options.every;
+        let recording = options.record.as_ref().map(|_| Recording {
+            version: VERSION,
+            build: BuildIdentity::current::<M>(),
+            source: loaded.source.clone(),
+            scene: loaded.scene.to_toml(),
+            capacity,
+            every: every.unwrap_or(10),
+            inputs: Vec::with_capacity(steps.min(1 << 20) as usize),
+            checkpoints: Vec::new(),
+        });
+        let frames = match &options.out {
+            Some(dir) => Some(output::Frames::new(dir, &loaded.prepared, every, steps)?),
+            None => None,
+        };
+        // The median step time from at most ~100,000 evenly spread steps: bounded memory on
+        // long runs.
+        let stride = (steps / 100_000).max(1);
+        Ok(Runner {
+            steps,
+            totals: Totals::default(),
+            last: StepReport::default(),
+            times: Vec::with_capacity((steps / stride + 1) as usize),
+            stride,
+            recording,
+            replayed: match inputs {
+                Inputs::Replay(r) => Some(r.checkpoints.iter().peekable()),
+                Inputs::Scene => None,
+            },
+            frames,
+            progress: Progress::new(options.progress, steps),
+        })
+    }
+
+    /// Books step `k` (0-based), which started at `start` and gave `report`: its time, its
+    /// totals, its recording and replay checkpoints, its frame, the progress bar.
+    fn after_step<const N: usize, M: Math>(
+        &mut self,
+        sim: &Sim<N, M>,
+        step_inputs: &StepInputs,
+        k: u64,
+        start: Instant,
+        report: StepReport,
+    ) -> Result<()> {
+        if k % self.stride == 0 {
+            self.times.push(start.elapsed().as_secs_f64());
         }
-        totals.add(&last);
+        self.totals.add(&report);
+        self.last = report;
         let done = k + 1;
-        if let Some(r) = &mut recording {
-            r.inputs.push(RecordedInputs::from_inputs(&step_inputs));
-            if done % r.every == 0 || done == steps {
+        if let Some(r) = &mut self.recording {
+            r.inputs.push(RecordedInputs::from_inputs(step_inputs));
+            if done % r.every == 0 || done == self.steps {
                 r.checkpoints.push(Checkpoint {
                     step: done,
                     hash: hash_string(sim.state_hash()),
                 });
             }
         }
-        if let Some((_, checkpoints)) = &mut replayed {
-            if let Some(c) = checkpoints.next_if(|c| c.step == done) {
-                let now = hash_string(sim.state_hash());
-                if now != c.hash {
-                    progress.finish();
-                    bail!(
-                        "replay differs at step {done}: recorded state hash {}, replayed {now}",
-                        c.hash
-                    );
-                }
-            }
-        }
-        if let Some(f) = &mut frames {
+        self.check_replay(sim, done)?;
+        if let Some(f) = &mut self.frames {
             f.after_step(done, &sim.strands, &sim.head)?;
         }
-        progress.tick(done);
+        self.progress.tick(done);
+        Ok(())
     }
-    progress.finish();
-    if let Some((_, checkpoints)) = &mut replayed {
-        if let Some(c) = checkpoints.next() {
+
+    /// A replay: the recorded hash at step `done`, if there is one, against the state's.
+    fn check_replay<const N: usize, M: Math>(&mut self, sim: &Sim<N, M>, done: u64) -> Result<()> {
+        let Some(checkpoints) = &mut self.replayed else {
+            return Ok(());
+        };
+        if let Some(c) = checkpoints.next_if(|c| c.step == done) {
+            let now = hash_string(sim.state_hash());
+            if now != c.hash {
+                self.progress.finish();
+                bail!(
+                    "replay differs at step {done}: recorded state hash {}, replayed {now}",
+                    c.hash
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// After the last step: no recorded checkpoint left over, the recording written, the
+    /// final frame and pictures written.
+    fn finish<const N: usize, M: Math>(
+        mut self,
+        sim: &Sim<N, M>,
+        options: &RunOptions,
+    ) -> Result<Outcome> {
+        self.progress.finish();
+        if let Some(c) = self.replayed.as_mut().and_then(Iterator::next) {
             bail!(
-                "the recording is damaged: checkpoint at step {} is past its {steps} steps",
-                c.step
+                "the recording is damaged: checkpoint at step {} is past its {} steps",
+                c.step,
+                self.steps
             );
         }
+        if let (Some(r), Some(path)) = (&self.recording, &options.record) {
+            r.write(path)?;
+        }
+        let written = match self.frames {
+            Some(f) => f.finish(&sim.strands, &sim.head)?,
+            None => Vec::new(),
+        };
+        Ok(Outcome {
+            steps: self.steps,
+            totals: self.totals,
+            last: self.last,
+            times: self.times,
+            written,
+        })
     }
-    if let (Some(r), Some(path)) = (&recording, &options.record) {
-        r.write(path)?;
-    }
-    let written = match frames {
-        Some(f) => f.finish(&sim.strands, &sim.head)?,
-        None => Vec::new(),
-    };
-    let grabs = !sim.grabs.is_empty();
-    Ok(Summary {
+}
+
+/// The summary of a finished run.
+fn summary<const N: usize, M: Math>(
+    loaded: &Loaded,
+    options: &RunOptions,
+    sim: &Sim<N, M>,
+    mut outcome: Outcome,
+) -> Summary {
+    let prepared = &loaded.prepared;
+    let totals = &outcome.totals;
+    Summary {
         scene: prepared.name.clone(),
         solver: prepared.params.solver.name().into(),
         math: M::NAME.into(),
@@ -396,15 +481,8 @@ fn run_n<const N: usize, M: Math>(
             .iter()
             .map(|e| e.name().to_string())
             .collect(),
-        hair_file: match &loaded.scene.hair {
-            Some(HairSpec::File(file)) => Some(HairFileUsed {
-                path: file.path.clone(),
-                scale: file.scale.unwrap_or(1.0),
-                up: file.up.clone().unwrap_or_else(|| "y".into()),
-            }),
-            _ => None,
-        },
-        steps,
+        hair_file: hair_file_used(&loaded.scene),
+        steps: outcome.steps,
         dt: prepared.params.dt,
         strands: sim.strands.len(),
         nodes: prepared.nodes(),
@@ -416,40 +494,56 @@ fn run_n<const N: usize, M: Math>(
         max_stretch: totals.max_stretch,
         max_penetration: totals.max_penetration,
         finite: sim.is_finite(),
-        ms_per_step: median_ms(&mut times),
+        ms_per_step: median_ms(&mut outcome.times),
         iterations: totals.iterations,
         caps_hit: totals.caps_hit,
         rolled_back: totals.rolled_back,
-        grab_forces: grabs.then(|| {
-            last.grab_forces[..sim.grabs.len()]
-                .iter()
-                .map(|f| f.to_array())
-                .collect()
-        }),
-        grab_status: grabs.then(|| {
-            sim.grabs
-                .iter()
-                .map(|g| {
-                    match g.status {
-                        GrabStatus::Held => "held",
-                        GrabStatus::Slipped => "slipped",
-                        GrabStatus::Released => "released",
-                    }
-                    .to_string()
-                })
-                .collect()
-        }),
+        grab_forces: (!sim.grabs.is_empty())
+            .then(|| vectors(&outcome.last.grab_forces[..sim.grabs.len()])),
+        grab_status: (!sim.grabs.is_empty()).then(|| grab_status(&sim.grabs)),
         sph_neighbours: sim.sph.as_ref().map(|sph| {
             let samples = sph.stats.runs as f64 * sph.particles().max(1) as f64;
             sph.stats.neighbours as f64 / samples.max(1.0)
         }),
         sph_truncated: sim.sph.as_ref().map(|sph| sph.stats.truncated),
-        written: written.iter().map(|p| p.display().to_string()).collect(),
-        collider_forces: (!sim.colliders.is_empty()).then(|| {
-            last.collider_forces[..sim.colliders.len()]
-                .iter()
-                .map(|f| f.to_array())
-                .collect()
+        written: outcome
+            .written
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect(),
+        collider_forces: (!sim.colliders.is_empty())
+            .then(|| vectors(&outcome.last.collider_forces[..sim.colliders.len()])),
+    }
+}
+
+/// The hair file a scene reads, as the summary names it.
+fn hair_file_used(scene: &Scene) -> Option<HairFileUsed> {
+    match &scene.hair {
+        Some(HairSpec::File(file)) => Some(HairFileUsed {
+            path: file.path.clone(),
+            scale: file.scale.unwrap_or(1.0),
+            up: file.up.clone().unwrap_or_else(|| "y".into()),
         }),
-    })
+        _ => None,
+    }
+}
+
+/// Forces as arrays, for the summary.
+fn vectors(forces: &[hairsim_core::Vec3]) -> Vec<[f32; 3]> {
+    forces.iter().map(|f| f.to_array()).collect()
+}
+
+/// Each grab's status, by name.
+fn grab_status(grabs: &[hairsim_core::Grab]) -> Vec<String> {
+    grabs
+        .iter()
+        .map(|g| {
+            match g.status {
+                GrabStatus::Held => "held",
+                GrabStatus::Slipped => "slipped",
+                GrabStatus::Released => "released",
+            }
+            .to_string()
+        })
+        .collect()
 }

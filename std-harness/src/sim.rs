@@ -3,19 +3,21 @@
 //! its own [`StepReport`] and the reports are merged in block order, so every bit of the state
 //! and of the report is the same whatever the thread count.
 //!
-//! The Kirchhoff rod steps each strand with [`hairsim_core::step_strands`]. DFTL steps each
-//! block as structure-of-arrays [`DftlBlock`]s of [`RECOMMENDED_LANES`] strands
-//! ([`hairsim_core::dftl::step_blocks`]: the same bits as the per-strand path, several times
+//! A step is the core's pipeline (`hairsim_core::pipeline`): the core begins it and ends it,
+//! and in between the harness adds SPH's accelerations and steps the blocks. The Kirchhoff rod
+//! steps each strand with [`hairsim_core::step_strands`]. DFTL steps each block as
+//! structure-of-arrays [`DftlBlock`]s of [`RECOMMENDED_LANES`] strands
+//! ([`hairsim_core::step_blocks`]: the same bits as the per-strand path, several times
 //! faster): the blocks keep the rest data, loaded once; every step copies the state in from
 //! the strands, steps, and copies it back while it is still in cache, so `strands` stays the
 //! state anyone reads or writes.
 
 use hairsim_core::context::StepContext;
-use hairsim_core::dftl::{step_blocks, DftlBlock, RECOMMENDED_LANES};
-use hairsim_core::grab::GrabStatus;
+use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
 use hairsim_core::params::DftlCoefficients;
+use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
-    step_strands, Collider, Flags, Grab, Math, Params, Pose, Real, Solver, Stage, StepReport,
+    step_blocks, step_strands, Collider, Grab, Math, Params, Pose, Real, Solver, Stage, StepReport,
     Strand, Vec3,
 };
 use rayon::prelude::*;
@@ -230,131 +232,171 @@ impl<const N: usize, M: Math> Sim<N, M> {
         }
     }
 
-    /// Advances by one step with `inputs`.
+    /// Advances by one step with `inputs`, a thin caller of the core's pipeline
+    /// (`hairsim_core::pipeline`): the core begins the step (input checks, context, grabs out
+    /// of reach), SPH adds its accelerations (SB15 Algorithm 1 lines 1–11, an input of the
+    /// step), the strands step through their solver's pipeline in blocks over threads, and
+    /// the core ends the step.
+    #[deny(clippy::too_many_lines, clippy::too_many_arguments)]
     pub fn step(&mut self, inputs: &StepInputs) -> StepReport {
         let mut report = StepReport::default();
-        for (g, grab) in self.grabs.iter_mut().enumerate() {
-            if inputs.released.get(g).copied().unwrap_or(false) {
-                grab.status = GrabStatus::Released;
-            }
-            match inputs.grab_targets.get(g) {
-                Some(t) if hairsim_core::math::is_finite(*t) => grab.target = *t,
-                Some(_) => report.flags.insert(Flags::BAD_INPUT),
-                None => {}
-            }
+        let world = Stepping {
+            params: &self.params,
+            dftl: self.dftl,
+            colliders: &self.colliders,
+            grabs: &mut self.grabs,
+            strands: &self.strands,
+            head: self.head,
+            steps: self.steps,
+        };
+        let inputs = Inputs {
+            head: inputs.head,
+            grab_targets: &inputs.grab_targets,
+            released: &inputs.released,
+        };
+        let ctx = pipeline::begin(world, &inputs, &mut report);
+        let hair_hair = self.hair_hair(&ctx, &mut report);
+        self.step_blocks(&ctx, hair_hair, &mut report);
+        pipeline::finish(&mut self.grabs, &report);
+        self.head = ctx.head;
+        self.steps += 1;
+        report
+    }
+
+    /// The SPH stage, when `hair-hair` is on and set up: every node's acceleration into
+    /// `self.accelerations`, counted like the core's stages (the strands it ran on). Returns
+    /// whether it ran.
+    fn hair_hair(&mut self, ctx: &StepContext, report: &mut StepReport) -> bool {
+        let Some(sph) = self.sph.as_mut().filter(|_| ctx.gates.hair_hair) else {
+            return false;
+        };
+        let (strands, out, dt) = (&self.strands, &mut self.accelerations, ctx.dt);
+        match &self.pool {
+            Some(pool) => pool.install(|| sph.accelerations(strands, dt, out)),
+            None => sph.accelerations(strands, dt, out),
         }
-        let head = if inputs.head.is_finite() {
-            inputs.head
-        } else {
-            report.flags.insert(Flags::BAD_INPUT);
-            self.head
+        report.ran_on(
+            Stage::HairHair,
+            u32::try_from(strands.len()).unwrap_or(u32::MAX),
+        );
+        true
+    }
+
+    /// The strands' step through their solver's pipeline, block by block (on the pool when
+    /// there is more than one block), each block with a report of its own, merged in block
+    /// order — never completion order: the same sums whatever the thread count.
+    fn step_blocks(&mut self, ctx: &StepContext, hair_hair: bool, report: &mut StepReport) {
+        let blocks = Blocks {
+            ctx,
+            block: self.block,
+            grabs: &self.grabs,
+            accelerations: hair_hair.then_some(self.accelerations.as_slice()),
         };
-        let t = time_after(self.steps, self.params.dt);
-        // As `World::step`: coefficients from set-up, the wind at the step's end time.
-        let ctx = StepContext::with_coefficients(
-            &self.params,
-            self.dftl,
-            self.head,
-            head,
-            &self.colliders,
-        )
-        .at_time(t);
-        let accelerations = match &mut self.sph {
-            Some(sph) if ctx.has(hairsim_core::Effect::HairHair) => {
-                let (strands, out, dt) = (&self.strands, &mut self.accelerations, ctx.dt);
-                match &self.pool {
-                    Some(pool) => pool.install(|| sph.accelerations(strands, dt, out)),
-                    None => sph.accelerations(strands, dt, out),
-                }
-                // Counted like the core's stages: the strands it ran on.
-                report.stage_runs[Stage::HairHair as usize] +=
-                    u32::try_from(strands.len()).unwrap_or(u32::MAX);
-                Some(self.accelerations.as_slice())
-            }
-            _ => None,
-        };
-        // A grab pulled out of the strand's reach lets go before the step (as `World::step`).
-        hairsim_core::grab::slip_unreachable(&ctx, &mut self.grabs, &self.strands, 0, &mut report);
-        let block = self.block;
-        let grabs = self.grabs.as_slice();
         let reports = &mut self.block_reports;
         let parallel = self.pool.as_ref().filter(|_| reports.len() > 1);
         if self.dftl_blocks.is_empty() {
-            let step_block = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
-                *r = StepReport::default();
-                let acc = accelerations
-                    .and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
-                step_strands::<M, N>(&ctx, strands, (b * block) as u32, grabs, acc, r);
-            };
-            match parallel {
-                Some(pool) => pool.install(|| {
-                    self.strands
-                        .par_chunks_mut(block)
-                        .zip(reports.par_iter_mut())
-                        .enumerate()
-                        .for_each(|(b, (strands, r))| step_block(b, strands, r));
-                }),
-                None => {
-                    for (b, (strands, r)) in self
-                        .strands
-                        .chunks_mut(block)
-                        .zip(reports.iter_mut())
-                        .enumerate()
-                    {
-                        step_block(b, strands, r);
-                    }
-                }
-            }
+            blocks.per_strand::<N, M>(&mut self.strands, reports, parallel);
         } else {
-            // DFTL ignores grabs (its followers' leaders are the strands themselves).
-            let per_block = block.div_ceil(LANES);
-            let step_block = |b: usize,
-                              strands: &mut [Strand<N>],
-                              blocks: &mut [DftlBlock<LANES, N>],
-                              r: &mut StepReport| {
-                *r = StepReport::default();
-                let acc = accelerations
-                    .and_then(|a| a.get(b * block * N..(b * block + strands.len()) * N));
-                for (lanes, chunk) in blocks.iter_mut().zip(strands.chunks(LANES)) {
-                    load_state(lanes, chunk);
-                }
-                step_blocks::<VectorSqrt<M>, LANES, N>(&ctx, blocks, (b * block) as u32, acc, r);
-                for (lanes, chunk) in blocks.iter().zip(strands.chunks_mut(LANES)) {
-                    lanes.store(chunk);
-                }
-            };
-            match parallel {
-                Some(pool) => pool.install(|| {
-                    self.strands
-                        .par_chunks_mut(block)
-                        .zip(self.dftl_blocks.par_chunks_mut(per_block))
-                        .zip(reports.par_iter_mut())
-                        .enumerate()
-                        .for_each(|(b, ((strands, blocks), r))| {
-                            step_block(b, strands, blocks, r);
-                        });
-                }),
-                None => {
-                    for (b, ((strands, blocks), r)) in self
-                        .strands
-                        .chunks_mut(block)
-                        .zip(self.dftl_blocks.chunks_mut(per_block))
-                        .zip(reports.iter_mut())
-                        .enumerate()
-                    {
-                        step_block(b, strands, blocks, r);
-                    }
-                }
-            }
+            blocks.soa::<N, M>(&mut self.strands, &mut self.dftl_blocks, reports, parallel);
         }
-        // Block order, never completion order: the same sums whatever the thread count.
         for r in reports.iter() {
             report.merge(r);
         }
-        hairsim_core::grab::apply_slips(&mut self.grabs, &report);
-        self.head = head;
-        self.steps += 1;
-        report
+    }
+}
+
+/// What every block of a step shares: the context, the block size, the grabs and the
+/// accelerations of all strands.
+struct Blocks<'a> {
+    ctx: &'a StepContext,
+    block: usize,
+    grabs: &'a [Grab],
+    accelerations: Option<&'a [Vec3]>,
+}
+
+impl Blocks<'_> {
+    /// The accelerations of block `b` of `strands` strands.
+    fn of_block<const N: usize>(&self, b: usize, strands: usize) -> Option<&[Vec3]> {
+        let first = b * self.block;
+        self.accelerations
+            .and_then(|a| a.get(first * N..(first + strands) * N))
+    }
+
+    /// Every block of `strands` through the core's per-strand pipeline.
+    fn per_strand<const N: usize, M: Math>(
+        &self,
+        strands: &mut [Strand<N>],
+        reports: &mut [StepReport],
+        parallel: Option<&std::sync::Arc<rayon::ThreadPool>>,
+    ) {
+        let step = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
+            *r = StepReport::default();
+            let acc = self.of_block::<N>(b, strands.len());
+            let first = (b * self.block) as u32;
+            step_strands::<M, N>(self.ctx, strands, first, self.grabs, acc, r);
+        };
+        match parallel {
+            Some(pool) => pool.install(|| {
+                let blocks = strands
+                    .par_chunks_mut(self.block)
+                    .zip(reports.par_iter_mut());
+                blocks
+                    .enumerate()
+                    .for_each(|(b, (strands, r))| step(b, strands, r));
+            }),
+            None => {
+                let blocks = strands.chunks_mut(self.block).zip(reports.iter_mut());
+                for (b, (strands, r)) in blocks.enumerate() {
+                    step(b, strands, r);
+                }
+            }
+        }
+    }
+
+    /// Every block of `strands` through the core's block pipeline (DFTL ignores grabs): each
+    /// block's state copied into its SoA blocks `soa`, stepped, and copied back while it is
+    /// still in cache.
+    fn soa<const N: usize, M: Math>(
+        &self,
+        strands: &mut [Strand<N>],
+        soa: &mut [DftlBlock<LANES, N>],
+        reports: &mut [StepReport],
+        parallel: Option<&std::sync::Arc<rayon::ThreadPool>>,
+    ) {
+        let per_block = self.block.div_ceil(LANES);
+        let step = |b: usize,
+                    strands: &mut [Strand<N>],
+                    blocks: &mut [DftlBlock<LANES, N>],
+                    r: &mut StepReport| {
+            *r = StepReport::default();
+            let acc = self.of_block::<N>(b, strands.len());
+            for (lanes, chunk) in blocks.iter_mut().zip(strands.chunks(LANES)) {
+                load_state(lanes, chunk);
+            }
+            let first = (b * self.block) as u32;
+            step_blocks::<VectorSqrt<M>, LANES, N>(self.ctx, blocks, first, acc, r);
+            for (lanes, chunk) in blocks.iter().zip(strands.chunks_mut(LANES)) {
+                lanes.store(chunk);
+            }
+        };
+        match parallel {
+            Some(pool) => pool.install(|| {
+                let blocks = strands.par_chunks_mut(self.block);
+                let blocks = blocks.zip(soa.par_chunks_mut(per_block));
+                blocks
+                    .zip(reports.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(b, ((strands, blocks), r))| step(b, strands, blocks, r));
+            }),
+            None => {
+                let blocks = strands
+                    .chunks_mut(self.block)
+                    .zip(soa.chunks_mut(per_block));
+                for (b, ((strands, blocks), r)) in blocks.zip(reports.iter_mut()).enumerate() {
+                    step(b, strands, blocks, r);
+                }
+            }
+        }
     }
 }
 
@@ -378,9 +420,9 @@ fn load_state<const N: usize>(block: &mut DftlBlock<LANES, N>, strands: &[Strand
 }
 
 /// Bending stiffness fading linearly from the root's to `tip` (≤ 1) times it at the last
-/// segment, in the rest data both solvers' stages read (`rest.bending_stiffness` and the rod's
-/// `rest.rod.bending_stiffness`). Only ever lowered, so the rod's stable time step (computed
-/// from the root's, the stiffest) stays valid.
+/// segment, in the rest data the rod's stages read (`rest.rod.bending_stiffness`), set once
+/// before the first step. Only ever lowered, so the rod's stable time step (computed from the
+/// root's, the stiffest) stays valid.
 fn fade_bending<const N: usize>(strand: &mut Strand<N>, tip: Real) {
     if tip == 1.0 {
         return;
@@ -389,7 +431,6 @@ fn fade_bending<const N: usize>(strand: &mut Strand<N>, tip: Real) {
     for j in 0..segments {
         let s = j as Real / (segments.max(2) - 1) as Real;
         let factor = 1.0 - s + s * tip;
-        strand.rest.bending_stiffness[j] *= factor;
         strand.rest.rod.bending_stiffness[j] *= factor;
     }
 }
@@ -417,10 +458,10 @@ mod tests {
         scene.strands_per_block = Some(40);
         let prepared = scene.prepare().unwrap();
         let mut blocks = Sim::<16, DefaultMath>::new(&prepared, 2).unwrap();
-        let mut per_strand = Sim::<16, DefaultMath>::new(&prepared, 2).unwrap();
+        let mut per_strand =
+            Sim::<16, DefaultMath>::with_layout(&prepared, 2, Layout::PerStrand).unwrap();
         // 12 blocks of 40 strands (3 SoA blocks: 16 + 16 + 8 lanes), then 20 strands (16 + 4).
         assert_eq!(blocks.dftl_blocks.len(), 12 * 3 + 2);
-        per_strand.dftl_blocks.clear();
         for k in 0..40 {
             let inputs = scene_inputs::<DefaultMath>(&prepared, k);
             let a = blocks.in_pool(|s| s.step(&inputs));

@@ -2,9 +2,8 @@
 //! Chentanez 2012, eq. 5): node `i` alone moves onto the sphere of radius `l_i` about the final
 //! node `i − 1` — one-sided and single-pass, the paper's point (TressFX moves both and iterates).
 
+use crate::lane::{Lane, V3};
 use crate::math::Math;
-
-use super::lane::{Lane, V3};
 
 /// `x*_i + Δx^inex_i = x*_{i−1} + l_i t_i` with `t_i = (x*_i − x*_{i−1}) / |x*_i − x*_{i−1}|`:
 /// eq. (10)'s `x*_i + (1 − l_i/|d|) d`, `d = x*_{i−1} − x*_i`, written so that the segment's

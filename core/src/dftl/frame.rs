@@ -2,7 +2,7 @@
 //! Harada 2012): a twist-free discrete Bishop frame whose first axis is the node's incoming
 //! edge, moved from node to node by the minimal rotation `q(t_{i−1} → t_i)`.
 //!
-//! DESIGN.md writes the frame as a unit quaternion `R_i`; here it is kept as its first two
+//! The paper writes the frame as a unit quaternion `R_i`; here it is kept as its first two
 //! columns, the unit tangent `t_i = R_i e_x` and normal `n_i = R_i e_y` (the third is
 //! `t_i × n_i`). The same rotation: `R_i = q(t_{i−1} → t_i) · R_{i−1}` moves `n_{i−1}` exactly
 //! as the quaternion product does, but as a Rodrigues rotation of one vector it needs one
@@ -10,9 +10,11 @@
 //! square root and a division per node). The step's tangent comes from the follow-the-leader
 //! projection, which already has `1/|e|`, so a frame costs no square root at all.
 
+use crate::lane::{Lane, V3};
 use crate::math::{self, Math, Quat, Vec3};
 
-use super::lane::{Lane, V3};
+use super::measures::Segment;
+use super::node::Chain;
 
 /// The frame whose x-axis is the unit vector `t`, the minimal rotation from `e_x` (`R̂_0`).
 /// A `t` opposite to `e_x` turns half a turn about z.
@@ -34,7 +36,7 @@ pub fn from_x_axis<M: Math>(t: Vec3) -> Quat {
 ///
 /// On a normal perpendicular to `t_{i−1}` the rotation also reduces to the two-reflection
 /// form `n − (t_i·n)/(1 + c) (t_{i−1} + t_i)`, half the arithmetic; measured on the 16-lane
-/// blocks (SSE2) it ran 7–10 % slower than this form (1,024 × 32 and 4,096 × 64, session 7),
+/// blocks (SSE2) it ran 7–10 % slower than this form (1,024 × 32 and 4,096 × 64),
 /// whose independent terms overlap the division, so this one stays.
 #[inline(always)]
 #[must_use]
@@ -44,6 +46,32 @@ pub fn transport<T: Lane>(tangent: V3<T>, normal: V3<T>, t: V3<T>) -> V3<T> {
     let one_plus_c = T::splat(1.0) + c;
     let turned = normal.scale(c) + k.cross(normal) + k.scale(k.dot(normal) / one_plus_c);
     V3::select(T::splat(1e-6).lt(one_plus_c), turned, normal)
+}
+
+/// SB15 Algorithm 1 line 21: the frame of the final node `i` carried from node `i − 1`'s
+/// (`chain`). Its tangent is `tangent` where `known` (follow-the-leader's, when no collider
+/// moved the node), else the unit edge of `segment` (`chain`'s tangent for a zero edge); its
+/// normal is [`transport`]ed. Returns `(t_i, n_i)`.
+#[inline(always)]
+#[must_use]
+pub fn carry<M: Math, T: Lane>(
+    chain: &Chain<T>,
+    segment: &Segment<T>,
+    tangent: V3<T>,
+    known: T::Mask,
+) -> (V3<T>, V3<T>) {
+    let t = if T::all(known) {
+        tangent
+    } else {
+        let length = segment.squared_length.sqrt::<M>();
+        let exact = V3::select(
+            T::splat(0.0).lt(length),
+            segment.edge.scale(T::splat(1.0) / length),
+            chain.tangent,
+        );
+        V3::select(known, tangent, exact)
+    };
+    (t, transport(chain.tangent, chain.normal, t))
 }
 
 /// `R v = v_x t + v_y n + v_z (t × n)`: a vector given in the frame `(t, n)`, in world axes.

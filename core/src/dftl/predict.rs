@@ -1,7 +1,7 @@
 //! SB15 Algorithm 1 lines 13–14: external accelerations and the prediction, eq. (1).
 
-use super::lane::{Lane, V3};
-use super::Setup;
+use super::node::Setup;
+use crate::lane::{Lane, V3};
 
 /// External acceleration of a free node: gravity and wind (`setup.base_acceleration`), drag
 /// `−ν v / m` when on, and the caller's acceleration (SPH, outside wind) where `has_extra`.

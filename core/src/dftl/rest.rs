@@ -1,29 +1,12 @@
-//! DFTL's rest data (Sánchez-Banderas 2015 Sec. 3.1 after Han & Harada 2012): the root frame
-//! `R̂_0` (as its tangent and normal) and the local rest vectors `r_i`, computed once in
-//! `Strand::from_polyline`, plus the per-segment factor the step measures strain with.
+//! DFTL's rest data (Sánchez-Banderas 2015 Sec. 3.1 after Han & Harada 2012), precomputed once
+//! when a strand is built (`Strand::from_polyline`): the root frame `R̂_0` (as its tangent and
+//! normal) and the local rest vectors `r_i`, plus the per-segment factor the step measures
+//! strain with.
 
 use crate::math::{self, Math, Real, Vec3};
+use crate::strand::DftlRest;
 
 use super::frame;
-
-/// What DFTL's shape constraints need of a strand at rest (in the head's frame).
-#[derive(Clone, Debug, PartialEq)]
-pub struct DftlRest<const N: usize> {
-    /// `t̂_0 = R̂_0 e_x`: the first rest segment's direction.
-    pub root_tangent: Vec3,
-    /// `n̂_0 = R̂_0 e_y`, `R̂_0` the minimal rotation from `e_x` to `t̂_0`.
-    pub root_normal: Vec3,
-    /// `r_i = R̂_{i−1}⁻¹ (x̂_i − x̂_{i−1})`: node `i`'s rest offset in the frame of node `i − 1`,
-    /// as components along `(t̂_{i−1}, n̂_{i−1}, t̂_{i−1} × n̂_{i−1})` (entries 0 and 1 unused:
-    /// those nodes are held by the head).
-    pub local_rest: [Vec3; N],
-    /// `d_i / L`: rest distance from the root along the strand over the strand's length, 0 at
-    /// the root and 1 at the tip (for coefficients that fade with distance from the root).
-    pub root_distance: [Real; N],
-    /// `1 / (2 l_{i−1}²)` for the segment ending at node `i` (0 for `i = 0`): the step measures
-    /// the strain `(|e|² − l²)/(2 l²)` without a square root or a division.
-    pub strain_scale: [Real; N],
-}
 
 impl<const N: usize> DftlRest<N> {
     /// Rest data of the polyline `points` (at least 2 nodes, at most `N`, no zero-length
@@ -81,7 +64,7 @@ impl<const N: usize> DftlRest<N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::dftl::lane::V3;
+    use crate::lane::V3;
     use crate::math::Libm;
 
     #[test]

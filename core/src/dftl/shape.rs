@@ -4,8 +4,8 @@
 //! rest distance from the root.
 
 use super::frame;
-use super::lane::{Lane, V3};
-use super::Setup;
+use super::node::Setup;
+use crate::lane::{Lane, V3};
 
 /// SB15 eq. (11): `Δx^gbl_i = s_g (p_i − x*_i)`, `p_i = T_head(x̂_i)` — the rest position
 /// carried rigidly by the head.

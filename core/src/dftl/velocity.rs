@@ -22,8 +22,8 @@
 //! The solver finishes each node one node behind, as soon as the next node's correction is
 //! known, so the whole step is one pass.
 
-use super::lane::{Lane, V3};
-use super::Setup;
+use super::node::Setup;
+use crate::lane::{Lane, V3};
 
 /// The node's new position and velocity from its predicted-and-projected position `x_star`,
 /// its position `x` at the start of the step and the next node's local-shape plus
@@ -40,18 +40,4 @@ pub fn finish<T: Lane>(
     let v = (x_star - x).scale(T::splat(setup.inv_dt))
         - next_correction.scale(T::splat(setup.damping_over_dt));
     (x_star, v)
-}
-
-/// 0 where every component of `v` is finite, NaN otherwise (`x − x`): both paths sum it over
-/// the velocities they write, and the guard needs nothing more.
-///
-/// Velocities only: a node's new velocity is `(x* − x)/Δt − (s_d/Δt) c` (or
-/// `(target − x)/Δt` for a held node), and with `x` finite (the last step's guard saw to
-/// that) and `1/Δt` finite and positive, a non-finite `x*` makes it non-finite too (`±∞` stays
-/// `±∞` or meets `∓∞` and turns NaN; NaN stays NaN) — so the positions need no check of their
-/// own, and a non-finite old `x` is caught the same way. DFTL writes no twist.
-#[inline(always)]
-#[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
-pub fn not_finite<T: Lane>(v: V3<T>) -> T {
-    (v.x - v.x) + (v.y - v.y) + (v.z - v.z)
 }

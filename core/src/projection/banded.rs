@@ -23,7 +23,7 @@ use crate::math::{Real, Vec3};
 
 /// Largest half-bandwidth the solver takes. The projection's segment rows need 1 (collision
 /// rows are eliminated at their node first, see [`eliminate_contacts`]); the room up to 3
-/// keeps the solver general (DESIGN.md's layouts with a node's rows in the band: a
+/// keeps the solver general (layouts with a node's rows in the band: a
 /// finite-mass pin has three) and is what its tests exercise.
 pub const MAX_HALF_BANDWIDTH: usize = 3;
 

@@ -353,9 +353,11 @@ impl<const N: usize> Default for ContactMemory<N> {
     }
 }
 
-/// Largest absolute coordinate of `p`.
+/// Largest absolute coordinate of `p` (how far from the origin f32's rounding is measured, and
+/// how far a collider reaches).
 #[inline(always)]
-fn magnitude(p: Vec3) -> Real {
+#[must_use]
+pub fn magnitude(p: Vec3) -> Real {
     p.x.abs().max(p.y.abs()).max(p.z.abs())
 }
 
@@ -525,13 +527,7 @@ fn detect_contacts<M: Math, const N: usize>(
     let x = &strand.state.position;
     let rest_length = &strand.rest.segment_length;
     let count = nodes.count.min(N);
-    // The previous iterate's rows: every other node's are empty already.
-    for k in 0..rows.contact_count.min(N) {
-        if let Some(contacts) = rows.contacts.get_mut(usize::from(rows.contact_nodes[k])) {
-            (contacts.count, contacts.tentative, contacts.kept) = (0, 0, 0);
-        }
-    }
-    rows.contact_count = 0;
+    rows.forget_contacts();
     let margin_fraction = if layout.contact_margin && !layout.residual_only {
         CONTACT_MARGIN
     } else {
@@ -563,53 +559,115 @@ fn detect_contacts<M: Math, const N: usize>(
             let Some((normal, depth)) = found else {
                 continue;
             };
-            let scale = rest_length[i - 1];
             if depth > 0.0 {
-                rows.residual = rows.residual.max(depth / scale);
-                rows.max_depth = rows.max_depth.max(depth);
-                if rows.converged && depth > tolerance * scale {
-                    let reach = match *shape {
-                        Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
-                        Shape::Plane { point, .. } => magnitude(point),
-                    };
-                    // Past 1 % of the segment f32 resolves nothing: not converged.
-                    let floor = resolution_floor(true, x[i], x[i], reach).min(0.01 * scale);
-                    rows.converged = depth <= floor;
-                }
+                rows.meet_contact(depth, rest_length[i - 1], tolerance, shape, x[i]);
             }
-            let tentative = !sticky && depth <= 0.0;
-            let (value, gradient) = contact(shape, normal, depth);
-            let contacts = &mut rows.contacts[i];
-            let first = contacts.count == 0;
-            let room = usize::from(contacts.count) < layout.contact_slots
-                || (!tentative && contacts.tentative != 0);
-            if room && contacts.push(c, value, gradient, tentative) {
-                if tentative {
-                    rows.tentative = true;
-                } else {
-                    memory.touched[i] |= bit;
-                }
-                if first {
-                    let last = rows.contact_count.checked_sub(1);
-                    ordered &= last.is_none_or(|k| usize::from(rows.contact_nodes[k]) < i);
-                    if let Some(slot) = rows.contact_nodes.get_mut(rows.contact_count) {
-                        *slot = i as u16;
-                        rows.contact_count += 1;
-                    }
-                }
-            } else if !tentative {
-                rows.truncated = true;
-            }
+            let found = Found {
+                node: i,
+                collider: c,
+                normal,
+                depth,
+                tentative: !sticky && depth <= 0.0,
+            };
+            ordered &= rows.add_contact(found, shape, layout, memory);
         }
     }
     if !ordered {
         // A later collider touched an earlier node: list them in node order again (the
         // solve's sums must not depend on the colliders' order).
-        rows.contact_count = 0;
+        rows.order_contact_nodes(count);
+    }
+}
+
+/// A contact [`detect_contacts`] found: a node, the collider, the outward normal and the
+/// depth (≤ 0 outside), and whether its row is tentative.
+#[derive(Clone, Copy, Debug)]
+struct Found {
+    node: usize,
+    collider: u8,
+    normal: Vec3,
+    depth: Real,
+    tentative: bool,
+}
+
+impl<const N: usize> Rows<N> {
+    /// Empties the previous iterate's collision rows (every other node's are empty already).
+    #[inline(always)]
+    fn forget_contacts(&mut self) {
+        for k in 0..self.contact_count.min(N) {
+            if let Some(contacts) = self.contacts.get_mut(usize::from(self.contact_nodes[k])) {
+                (contacts.count, contacts.tentative, contacts.kept) = (0, 0, 0);
+            }
+        }
+        self.contact_count = 0;
+    }
+
+    /// A node `depth` inside `shape` at `p`, with `scale` the rest length of the segment
+    /// before it: into the residual, the deepest penetration and the convergence test.
+    #[inline(always)]
+    fn meet_contact(&mut self, depth: Real, scale: Real, tolerance: Real, shape: &Shape, p: Vec3) {
+        self.residual = self.residual.max(depth / scale);
+        self.max_depth = self.max_depth.max(depth);
+        if self.converged && depth > tolerance * scale {
+            let reach = match *shape {
+                Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,
+                Shape::Plane { point, .. } => magnitude(point),
+            };
+            // Past 1 % of the segment f32 resolves nothing: not converged.
+            let floor = resolution_floor(true, p, p, reach).min(0.01 * scale);
+            self.converged = depth <= floor;
+        }
+    }
+
+    /// The collision row of `found` against `shape`, if its node has room (a contact found
+    /// inside takes a tentative one's place; past the room it is flagged `truncated`), and the
+    /// node listed with the contact nodes when it is its first row. A row that is not
+    /// tentative is remembered in `memory`. Returns whether the contact nodes are still in
+    /// node order.
+    #[inline(always)]
+    fn add_contact(
+        &mut self,
+        found: Found,
+        shape: &Shape,
+        layout: Layout,
+        memory: &mut ContactMemory<N>,
+    ) -> bool {
+        let (i, c, tentative) = (found.node, found.collider, found.tentative);
+        let (value, gradient) = contact(shape, found.normal, found.depth);
+        let contacts = &mut self.contacts[i];
+        let first = contacts.count == 0;
+        let room = usize::from(contacts.count) < layout.contact_slots
+            || (!tentative && contacts.tentative != 0);
+        if !(room && contacts.push(c, value, gradient, tentative)) {
+            if !tentative {
+                self.truncated = true;
+            }
+            return true;
+        }
+        if tentative {
+            self.tentative = true;
+        } else {
+            memory.touched[i] |= 1u8 << (c % 8);
+        }
+        let mut ordered = true;
+        if first {
+            let last = self.contact_count.checked_sub(1);
+            ordered = last.is_none_or(|k| usize::from(self.contact_nodes[k]) < i);
+            if let Some(slot) = self.contact_nodes.get_mut(self.contact_count) {
+                *slot = i as u16;
+                self.contact_count += 1;
+            }
+        }
+        ordered
+    }
+
+    /// Lists the nodes with collision rows in node order.
+    fn order_contact_nodes(&mut self, count: usize) {
+        self.contact_count = 0;
         for i in 2..count {
-            if rows.contacts[i].count > 0 {
-                rows.contact_nodes[rows.contact_count] = i as u16;
-                rows.contact_count += 1;
+            if self.contacts[i].count > 0 {
+                self.contact_nodes[self.contact_count] = i as u16;
+                self.contact_count += 1;
             }
         }
     }

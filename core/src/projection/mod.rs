@@ -28,8 +28,8 @@
 //! plus the node's own weight and inertia, `−Σ_adjacent ∇_{x_g}C_jᵀΛ_j/h² − m_g(a_g − g)`;
 //! `m_g(a_g − g)` (with every external acceleration the node got, not only gravity) is
 //! `m_g Δx_g / h²`, the impulse that took the node from its predicted position to the target.
-//! (DESIGN.md prints `+ m_g(a_g − g)`; at rest that would subtract the node's own weight from
-//! the weight held — the two terms must have the same sign, as its 1.7 % remark says.)
+//! (Written `+ m_g(a_g − g)`, the force at rest would subtract the node's own weight from the
+//! weight held: the two terms must have the same sign, as the paper's 1.7 % remark says.)
 
 pub mod banded;
 pub mod constraints;
@@ -44,7 +44,7 @@ use crate::report::{Flags, Stage, StepReport};
 use crate::strand::Strand;
 
 use banded::BandRow;
-use constraints::{ContactMemory, Layout, Nodes, Rows, MAX_NODE_CONTACTS};
+use constraints::{magnitude, ContactMemory, Layout, Nodes, Rows, MAX_NODE_CONTACTS};
 
 /// What one projection did, besides what it adds to the report.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -440,11 +440,6 @@ impl NearColliders {
     }
 }
 
-/// Largest absolute coordinate of `p`.
-fn magnitude(p: Vec3) -> Real {
-    p.x.abs().max(p.y.abs()).max(p.z.abs())
-}
-
 /// Whether some point of the box `low`–`high` may lie inside `shape` (never `false` when one
 /// does; `true` when unsure). The shape is grown by 1e-5 of its own coordinates, far above
 /// the rounding of the per-node tests (`Shape::penetration`) far from the origin.
@@ -492,53 +487,16 @@ fn solve_and_move<M: Math, const N: usize>(
 ) -> Option<(u32, Real)> {
     let n = work.nodes.count.min(N);
     let count = work.rows.count.min(N);
-    let mut dropped = 0;
-    // Tentative collision rows (converge mode) stay only where they push: a solve whose
-    // tentative rows pull is redone without those rows (an active-set step on the
-    // linearised contacts), twice at most, then once more without any tentative row (the
-    // solve without the margin) if some still pull. Only the last solve's dropped rows count.
-    // On Table 3's draped strands a second solve is needed in one iteration in five.
-    for pass in 0..4 {
-        dropped = banded::eliminate_contacts(&mut work.rows, n);
-        let band = work.band.get_mut(..count)?;
-        let multipliers = work.multipliers.get_mut(..count)?;
-        let (rows, first) = (work.rows.rows(), work.rows.first());
-        dropped += banded::solve_chain(rows, first, &work.nodes.inverse_mass, band, multipliers);
-        if !work.rows.tentative || !multipliers.iter().all(|l| l.is_finite()) {
-            break;
-        }
-        let all = pass >= 2;
-        if !prune_tentative(
-            &mut work.rows,
-            multipliers,
-            &work.nodes.inverse_mass,
-            n,
-            all,
-        ) {
-            break;
-        }
-        banded::undo_elimination(&mut work.rows);
-    }
+    let dropped = solve(work, n, count)?;
     let rows = work.rows.rows();
     let multipliers = work.multipliers.get(..count)?;
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
-    // Δx: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact),
-    // contacts by −d_i. Gathered per node from its two segments (segment i − 1 first, as the
-    // rows are in segment order), with the longest move for the trust region below in the
-    // same pass.
-    //
-    // Trust region: Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê)
-    // asks for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled
-    // down whole (its direction kept): garbage then converges slowly instead of exploding.
-    // Legitimate iterates do overshoot: in a violent step (the firmware scene's strand 1 at
-    // ~20 m/s, predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and
-    // the next ones converged; a radius of one strand length cut that short and broke the
-    // iteration. Hence ten strand lengths.
-    // Gathered per node from its two segments (segment i − 1 first, as the rows are in
-    // segment order) and its contacts, with the longest move in the same pass. A node
-    // without collision rows has `kept = 0` (see `Rows::contacts`).
+    // Δx: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact), contacts
+    // by −d_i. Gathered per node from its two segments (segment i − 1 first, as the rows are in
+    // segment order) and its contacts, with the longest move for the trust region below in
+    // the same pass. A node without collision rows has `kept = 0` (see `Rows::contacts`).
     let mut any_contact = false;
     let mut longest2: Real = 0.0;
     let segment_row = &work.rows.segment_row;
@@ -572,22 +530,88 @@ fn solve_and_move<M: Math, const N: usize>(
         }
         *dx = delta;
     }
-    let step = &work.step;
     if !longest2.is_finite() {
         return None;
     }
-    let bound = work.trust_radius;
-    let scale = if longest2 > bound * bound {
+    let scale = trust_scale::<M>(longest2, work.trust_radius);
+    for (x, dx) in strand
+        .state
+        .position
+        .iter_mut()
+        .zip(work.step.iter())
+        .take(n)
+    {
+        *x += *dx * scale;
+    }
+    pull_on_grabs(work, held, count, scale);
+    if any_contact {
+        push_on_colliders(work, count, n, scale);
+    }
+    Some((dropped, longest2))
+}
+
+/// The scale of an iteration's moves, the longest `√longest2` long, within the trust radius
+/// `bound`. Newton on `e·e − ê·ê` from a nearly collapsed segment (|e| → 0, C → −ê·ê) asks
+/// for a move of ê²/(2|e|), unbounded. A step longer than the trust radius is scaled down
+/// whole (its direction kept): garbage then converges slowly instead of exploding. Legitimate
+/// iterates do overshoot: in a violent step (the firmware scene's strand 1 at ~20 m/s,
+/// predicted 2–3 cm off per node) an iterate moved a node 1.5 strand lengths and the next
+/// ones converged; a radius of one strand length cut that short and broke the iteration.
+/// Hence ten strand lengths ([`TRUST_RADIUS_IN_STRAND_LENGTHS`]).
+#[inline(always)]
+fn trust_scale<M: Math>(longest2: Real, bound: Real) -> Real {
+    if longest2 > bound * bound {
         bound / M::sqrt(longest2)
     } else {
         1.0
-    };
-    for (x, dx) in strand.state.position.iter_mut().zip(step.iter()).take(n) {
-        *x += *dx * scale;
     }
-    // Forces from the multipliers actually applied (`scale · δλ`): only for held grabs.
-    let grabbed = if held.is_empty() { &[] } else { rows };
-    for (row, &lambda) in grabbed.iter().zip(multipliers.iter()) {
+}
+
+/// The multipliers `δλ` of `(∇C M⁻¹ ∇Cᵀ) δλ = C` into `work.multipliers`: each node's
+/// collision rows eliminated at their node first, then the segments' chain solved. Tentative
+/// collision rows (converge mode) stay only where they push: a solve whose tentative rows pull
+/// is redone without those rows (an active-set step on the linearised contacts), twice at
+/// most, then once more without any tentative row (the solve without the margin) if some
+/// still pull. Only the last solve's dropped rows count. On Table 3's draped strands a second
+/// solve is needed in one iteration in five. Returns the rows dropped at a singular pivot.
+#[inline(always)]
+fn solve<const N: usize>(work: &mut Workspace<N>, n: usize, count: usize) -> Option<u32> {
+    let mut dropped = 0;
+    for pass in 0..4 {
+        dropped = banded::eliminate_contacts(&mut work.rows, n);
+        let band = work.band.get_mut(..count)?;
+        let multipliers = work.multipliers.get_mut(..count)?;
+        let (rows, first) = (work.rows.rows(), work.rows.first());
+        dropped += banded::solve_chain(rows, first, &work.nodes.inverse_mass, band, multipliers);
+        if !work.rows.tentative || !multipliers.iter().all(|l| l.is_finite()) {
+            break;
+        }
+        let all = pass >= 2;
+        let inverse_mass = &work.nodes.inverse_mass;
+        if !prune_tentative(&mut work.rows, multipliers, inverse_mass, n, all) {
+            break;
+        }
+        banded::undo_elimination(&mut work.rows);
+    }
+    Some(dropped)
+}
+
+/// The segments' pull on each held grab's node from the multipliers actually applied
+/// (`scale · δλ`), into `work.grab_pull`.
+#[inline(always)]
+fn pull_on_grabs<const N: usize>(
+    work: &mut Workspace<N>,
+    held: &GrabbedNodes,
+    count: usize,
+    scale: Real,
+) {
+    let rows = if held.is_empty() {
+        &[]
+    } else {
+        work.rows.rows()
+    };
+    let multipliers = work.multipliers.get(..count).unwrap_or(&[]);
+    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
         for (&node, &gradient) in row.nodes.iter().zip(row.gradients().iter()) {
             let i = usize::from(node);
             if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
@@ -595,13 +619,16 @@ fn solve_and_move<M: Math, const N: usize>(
             }
         }
     }
-    // Collider forces: only where a node kept a contact row this iteration.
-    let contact_nodes = if any_contact {
-        work.rows.contact_count.min(N)
-    } else {
-        0
-    };
-    for k in 0..contact_nodes {
+}
+
+/// Each collider's share of the multipliers actually applied (`scale · δλ`), from the nodes
+/// that kept a contact row this iteration: its push (`work.collider_push`), each node's summed
+/// multiplier per collider, and the node marked as touching it (a tentative row that stayed
+/// pushes: a contact from now on).
+#[inline(always)]
+fn push_on_colliders<const N: usize>(work: &mut Workspace<N>, count: usize, n: usize, scale: Real) {
+    let multipliers = work.multipliers.get(..count).unwrap_or(&[]);
+    for k in 0..work.rows.contact_count.min(N) {
         let i = usize::from(work.rows.contact_nodes[k]);
         let Some(&contacts) = work.rows.contacts.get(i) else {
             continue;
@@ -613,13 +640,12 @@ fn solve_and_move<M: Math, const N: usize>(
         let w = work.nodes.inverse_mass[i];
         let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
         let kept = usize::from(contacts.kept);
-        for ((&c, &gradient), &lambda) in contacts
+        let rows = contacts
             .collider
             .iter()
             .zip(contacts.gradient.iter())
-            .zip(lambdas.iter())
-            .take(kept)
-        {
+            .zip(lambdas.iter());
+        for ((&c, &gradient), &lambda) in rows.take(kept) {
             let c = usize::from(c);
             if let Some(push) = work.collider_push.get_mut(c) {
                 *push += gradient * (lambda * scale);
@@ -627,11 +653,9 @@ fn solve_and_move<M: Math, const N: usize>(
             if let Some(sum) = work.contacts.multipliers[i].get_mut(c) {
                 *sum += lambda * scale;
             }
-            // A tentative row that stayed pushes: a contact from now on.
             work.contacts.touched[i] |= 1 << (c % 8);
         }
     }
-    Some((dropped, longest2))
 }
 
 /// Removes the tentative collision rows whose multiplier does not push (`δλ ≥ 0`: the row

@@ -1,10 +1,10 @@
 //! Linearly implicit bending: one elastic step per time step at any bending stiffness the
 //! validator accepts, with a banded solve per strand in fixed storage. A strand takes it when
-//! it would need [`IMPLICIT_FROM`](super::step::IMPLICIT_FROM) or more explicit substeps
-//! (stiffer than human hair, tight curls; `rod::step` says why not below).
+//! it would need [`IMPLICIT_FROM`](super::substeps::IMPLICIT_FROM) or more explicit substeps
+//! (stiffer than human hair, tight curls; `rod::substeps` says why not below).
 //!
 //! Symplectic Euler on the bending forces is only stable for `dt ≤ dt_max`
-//! ([`RodRest::stable_time_step`](super::energy::RodRest)); human hair at 1 cm and 1 ms sits
+//! ([`RodRest::stable_time_step`](crate::strand::RodRest)); human hair at 1 cm and 1 ms sits
 //! near that limit and ×1000 stiffer hair 20× past it. Linearised backward Euler on the
 //! velocities (Baraff & Witkin 1998, eq. 6, written for the new velocity):
 //!
@@ -37,8 +37,11 @@
 //! the system. The band is factored as `L D Lᵀ` (no square roots; one division per row) and
 //! solved in O(n), in storage sized by `N`.
 
-use super::energy::{RodFrames, RodRest};
+use super::frames::RodFrames;
+use crate::context::StepContext;
+use crate::forces::{acceleration, drag};
 use crate::math::{Math, Real, Vec3};
+use crate::strand::{RodRest, Strand};
 
 /// Half-bandwidth of `M + h² H̃` in scalar unknowns: node `i`'s row reaches node `i − 2`'s
 /// last axis, `3·2 + 2`.
@@ -544,6 +547,55 @@ impl<const N: usize> BendingSystem<N> {
             }
             *value = sum;
         }
+    }
+}
+
+/// Kmoch 2009 Algorithm 1 line 4 as one linearly implicit step of `h = dt` for the bending
+/// (see the module documentation): `(M + h² H̃) v⁺ = M (v + h a)` and `x⁺ = x + h v⁺`, with
+/// `a` the acceleration of the explicit step from the elastic forces `forces` and the
+/// external forces ([`crate::forces::acceleration`]), and `H̃` assembled at `frames`, those of
+/// the centreline the step starts from. Nodes 0 and 1 stay put; `held_velocity` is the
+/// velocity the head gives them this step (`root_coupling::held_velocity`), a boundary
+/// condition of the solve.
+pub fn step<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    frames: &RodFrames<M, N>,
+    forces: &[Vec3; N],
+    held_velocity: [Vec3; 2],
+    accelerations: Option<&[Vec3]>,
+) {
+    let h = ctx.dt;
+    let n = strand.rest.nodes.min(N);
+    let mut system = BendingSystem::<N>::default();
+    system.assemble(frames, &strand.rest.mass, &strand.rest.rod, h);
+    system.factor();
+    let drag = drag(ctx);
+    // Right-hand side M (v + h a), with a as in the explicit step.
+    let mut rhs = [[0.0; 3]; N];
+    let state = &mut strand.state;
+    let rest = &strand.rest;
+    let nodes = rhs
+        .iter_mut()
+        .zip(&state.velocity)
+        .zip(forces.iter().zip(rest.mass.iter().zip(&rest.inverse_mass)))
+        .enumerate()
+        .take(n)
+        .skip(2);
+    for (i, ((slot, v), (force, (mass, inverse_mass)))) in nodes {
+        let a = acceleration(ctx, *force, *v, drag, *inverse_mass, accelerations, i);
+        *slot = ((*v + a * h) * *mass).to_array();
+    }
+    BendingSystem::move_held_nodes(frames, &rest.rod, h, held_velocity, &mut rhs);
+    system.solve(&mut rhs);
+    let nodes = rhs
+        .iter()
+        .zip(state.velocity.iter_mut().zip(state.position.iter_mut()))
+        .take(n)
+        .skip(2);
+    for (solved, (v, x)) in nodes {
+        *v = Vec3::from_array(*solved);
+        *x += *v * h;
     }
 }
 

@@ -1,19 +1,27 @@
-//! The Kirchhoff-rod solver of Kmoch, Bonanni and Magnenat-Thalmann 2009 (after Bergou et al.
-//! 2008): a Bishop frame, hair-optimised twist, symplectic Euler and a fast manifold projection.
+//! The stages of the Kirchhoff-rod solver of Kmoch, Bonanni and Magnenat-Thalmann 2009 (after
+//! Bergou et al. 2008): a Bishop frame, hair-optimised twist, symplectic Euler and a fast
+//! manifold projection (`crate::projection`). The pipeline that runs them is `pipeline::rod`.
 //!
-//! * [`energy`] — rest state, bending and twist energies, their gradients and the elastic forces.
-//! * [`twist`] — the quasistatic twist: hair-optimised (Sec. 6.2) or Newton (BWR08).
-//! * [`step`] — Algorithm 1 as a list of stages.
+//! * [`rest`] — Algorithm 1 line 1: the rest-state values.
+//! * [`frames`] — the frames of a configuration: segments, binormals, the Bishop frame in space.
+//! * [`energy`] — bending and twist energies, their gradients and the elastic forces (line 3).
+//! * [`substeps`] — how many explicit substeps a strand takes, or the implicit step (lines 3–4).
+//! * [`integrate`] — symplectic Euler (line 4).
+//! * [`implicit`] — the linearly implicit bending step for stiff strands (lines 3–4).
+//! * [`twist`] — the quasistatic twist: hair-optimised (Sec. 6.2) or Newton (BWR08) (line 10).
 
+use crate::context::Gates;
 use crate::grab::{Grab, GrabStatus};
 
 pub mod energy;
+pub mod frames;
 pub mod implicit;
-pub mod step;
+pub mod integrate;
+pub mod rest;
+pub mod substeps;
 pub mod twist;
 
-/// Most clamped segments besides the root a strand may have (one per grab, with room to spare).
-pub const MAX_CLAMPED: usize = 8;
+pub use crate::capacities::MAX_CLAMPED;
 
 /// The clamped set `C` of Kmoch Sec. 7.2: segments whose material frame is held rather than
 /// solved for by the twist. The root segment 0 is always clamped (the head holds it); a grabbed
@@ -72,6 +80,17 @@ impl ClampedSegments {
         set
     }
 
+    /// The clamped set of a step: [`Self::from_grabs`] with the `grabs` effect on, the root
+    /// alone without.
+    #[must_use]
+    pub fn of_step(gates: &Gates, grabs: &[Grab], strand_index: u32, nodes: usize) -> Self {
+        if gates.grabs {
+            ClampedSegments::from_grabs(grabs, strand_index, nodes)
+        } else {
+            ClampedSegments::ROOT_ONLY
+        }
+    }
+
     /// Whether segment `segment` is clamped (always for segment 0).
     #[must_use]
     pub fn contains(&self, segment: usize) -> bool {
@@ -96,6 +115,16 @@ pub struct ElasticTerms {
 }
 
 impl ElasticTerms {
+    /// The energies a step's gates turn on.
+    #[inline(always)]
+    #[must_use]
+    pub fn of(gates: &Gates) -> Self {
+        ElasticTerms {
+            bending: gates.bending,
+            twist: gates.twist,
+        }
+    }
+
     /// Both energies.
     pub const ALL: ElasticTerms = ElasticTerms {
         bending: true,

@@ -12,95 +12,63 @@
 //! by the time-parallel transport of their material frame.
 
 use super::energy::{
-    bending_matrix, bending_twist_derivative, elastic_energy, material_angles, material_curvature,
-    node_twist_energy, representative_near, twist_stiffness, twist_twist_derivative, RodFrames,
-    RodRest,
+    bending_matrix, bending_twist_derivative, elastic_energy, node_twist_energy, twist_stiffness,
+    twist_twist_derivative,
 };
-use super::{ClampedSegments, ElasticTerms, MAX_CLAMPED};
+use super::frames::{
+    binormal_direction, material_angles, material_curvature, representative_near, RodFrames,
+};
+use super::{ClampedSegments, ElasticTerms};
+use crate::capacities::MAX_CLAMPED;
+use crate::context::StepContext;
 use crate::frames::{angle_in_frame, material_frame, parallel_transport, unwrap_near};
+use crate::math::{Math, Real};
+use crate::params::Mode;
 use crate::precision::{Precision, Scalar, Vector};
+use crate::report::{Flags, Stage, StepReport};
+use crate::strand::{RodRest, Strand};
 
-/// Which quasistatic twist a scene uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum TwistMethod {
-    /// Kmoch 2009 Sec. 6.2: material frames follow the curvature binormals.
-    HairOptimised,
-    /// BWR08: Newton's method on the tridiagonal twist Hessian.
-    Newton,
-}
+pub use crate::params::TwistMethod;
 
-impl TwistMethod {
-    /// The method's name in scene files (`"hair-optimised"`, `"newton"`).
-    #[must_use]
-    pub const fn name(self) -> &'static str {
-        match self {
-            TwistMethod::HairOptimised => "hair-optimised",
-            TwistMethod::Newton => "newton",
+/// Kmoch 2009 Algorithm 1 line 10, "compute twist", for the strand's new centreline, whose
+/// frames `frames` are (line 9): the clamped segments' material frames by time-parallel
+/// transport from `saved` (Sec. 6.1; none with only the root clamped), then the free angles
+/// by the scene's [`TwistMethod`]. `angles` are `(cos θ^j, sin θ^j)` from the start of the
+/// step: only clamped segments (skipped by the sweep) have moved since.
+pub fn update<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    clamped: &ClampedSegments,
+    frames: &RodFrames<M, N>,
+    saved: Option<&ClampedFrames<M>>,
+    angles: &[[Real; 2]; N],
+    report: &mut StepReport,
+) {
+    report.ran(Stage::Twist);
+    let terms = ElasticTerms::of(&ctx.gates);
+    let segments = strand.rest.nodes.saturating_sub(1).min(N);
+    let rest = &strand.rest.rod;
+    let theta = &mut strand.state.theta[..segments];
+    if let Some(saved) = saved {
+        saved.transport(frames, clamped, theta);
+    }
+    match ctx.params.rod.twist {
+        TwistMethod::HairOptimised => {
+            hair_optimised_twist_with_angles(frames, rest, clamped, terms, theta, angles);
+        }
+        TwistMethod::Newton => {
+            let settings = NewtonSettings {
+                iterations: ctx.params.rod.newton_iterations,
+                tolerance: ctx.params.rod.newton_tolerance,
+                fixed_cost: ctx.params.mode == Mode::FixedCost,
+            };
+            let outcome = newton_twist(frames, rest, clamped, terms, settings, theta);
+            report.iterations_max = report.iterations_max.max(outcome.iterations);
+            if !outcome.converged {
+                report.flags.insert(Flags::CAP_HIT);
+            }
         }
     }
-}
-
-/// `ε²` in the binormal weights `|κb|² / (|κb|² + ε²)`: binormals much shorter than
-/// `ε = 1e-4` (a turning angle of 0.1 mrad) fade out of the average instead of dropping out at a
-/// threshold, so `θ` does not jump when a node straightens.
-const BINORMAL_FADE: f32 = 1.0e-8;
-/// Below this weight neither binormal says anything: the segment continues its neighbour.
-const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
-
-/// The direction `(cos φ, sin φ)`, defined mod π, that segment `j`'s material vector `m1`
-/// takes in the hair-optimised twist: the mean of the directions of the binormals at nodes `j`
-/// and `j + 1` in the Bishop frame of segment `j` (Kmoch Sec. 6.2), averaged as lines:
-/// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
-/// doubled angle is a complex square, the half angle a square root.
-///
-/// Two divisions: the weights `1/r_k` share one (`Σ z_k/r_k` is kept as a fraction), and the
-/// half angle of `z = X + iY` is `(|z| + X, Y)` (or `(Y, |z| − X)`, the same line, when
-/// `X < 0`), normalised once.
-#[inline(always)]
-#[must_use]
-pub fn binormal_direction<P: Precision, const N: usize>(
-    frames: &RodFrames<P, N>,
-    j: usize,
-) -> Option<[P::R; 2]> {
-    let n = frames.interior();
-    let fade = P::R::of(BINORMAL_FADE);
-    // Σ_k z_k / r_k with z_k = (a² − b², 2ab) and r_k = a² + b² + ε², as `sum / scale`.
-    let mut sum = [P::R::ZERO; 2];
-    let mut scale = P::R::ONE;
-    // (κb·u^j, κb·v^j) = (−p₁, p₀) for node j (frame j = its "next") and node j + 1 ("prev").
-    let mut add = |p: [P::R; 2]| {
-        let (a, b) = (-p[1], p[0]);
-        let r = a * a + b * b + fade;
-        sum[0] = sum[0] * r + (a * a - b * b) * scale;
-        sum[1] = sum[1] * r + P::R::of(2.0) * a * b * scale;
-        scale *= r;
-    };
-    if j >= 1 && j <= n {
-        add(frames.bishop_curvature[j][1]);
-    }
-    if j < n {
-        add(frames.bishop_curvature[j + 1][0]);
-    }
-    let inverse_scale = P::R::ONE / scale;
-    let (x, y) = (sum[0] * inverse_scale, sum[1] * inverse_scale);
-    let weight2 = x * x + y * y;
-    let min = P::R::of(BINORMAL_MIN_WEIGHT);
-    if weight2 <= min * min || !weight2.is_finite() {
-        return None;
-    }
-    let weight = P::sqrt(weight2);
-    let half_angle = if x >= P::R::ZERO {
-        [weight + x, y]
-    } else {
-        [y, weight - x]
-    };
-    let inverse_length =
-        P::R::ONE / P::sqrt(half_angle[0] * half_angle[0] + half_angle[1] * half_angle[1]);
-    Some([
-        half_angle[0] * inverse_length,
-        half_angle[1] * inverse_length,
-    ])
 }
 
 /// The bending energy of nodes `j`, `j + 1` in frame `j` at `θ` and at `θ ± π`:
@@ -377,61 +345,32 @@ const LINE_SEARCH_HALVINGS: u32 = 4;
 /// non-positive pivot, the iteration uses Gauss–Newton (the `−ωᵀB(ω−ω̂)` term dropped, positive
 /// semi-definite plus the twist Laplacian), and every step is safeguarded by a backtracking
 /// line search on `E` (BWR08 leaves globalisation open). Stops when the largest update is `≤ tolerance` rad,
-/// unless `fixed_cost`, which always runs `iterations` (bounded latency).
-#[allow(clippy::too_many_arguments)]
+/// unless `settings.fixed_cost`, which always runs `settings.iterations` (bounded latency).
 pub fn newton_twist<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     clamped: &ClampedSegments,
     terms: ElasticTerms,
-    iterations: u16,
-    tolerance: P::R,
-    fixed_cost: bool,
+    settings: NewtonSettings<P::R>,
     theta: &mut [P::R],
 ) -> NewtonOutcome {
     let segments = frames.nodes.saturating_sub(1).min(theta.len());
     let mut outcome = NewtonOutcome::default();
-    let mut gradient = [P::R::ZERO; N];
-    let mut full = [P::R::ZERO; N];
-    let mut gauss_newton = [P::R::ZERO; N];
-    let mut coupling = [P::R::ZERO; N];
+    let mut system = NewtonSystem::<P::R, N>::default();
     let mut step = [P::R::ZERO; N];
     let mut pivots = [P::R::ONE; N];
-    for _ in 0..iterations {
+    for _ in 0..settings.iterations {
         twist_newton_system(
             frames,
             rest,
             clamped,
             terms,
             &theta[..segments],
-            &mut gradient,
-            &mut full,
-            &mut gauss_newton,
-            &mut coupling,
+            &mut system,
         );
         outcome.iterations += 1;
-        let rows = ..segments;
-        if !solve_tridiagonal(
-            &full[rows],
-            &coupling[rows],
-            &gradient[rows],
-            &mut pivots[rows],
-            &mut step[rows],
-        ) {
-            // Not positive definite: Gauss–Newton, positive definite whenever β > 0.
+        if !system.solve(segments, &mut pivots, &mut step) {
             outcome.gauss_newton += 1;
-            for g in gauss_newton[rows].iter_mut() {
-                if *g <= P::R::ZERO || !g.is_finite() {
-                    *g = P::R::of(1.0e-30);
-                }
-            }
-            solve_tridiagonal(
-                &gauss_newton[rows],
-                &coupling[rows],
-                &gradient[rows],
-                &mut pivots[rows],
-                &mut step[rows],
-            );
         }
         let limit = P::R::of(MAX_NEWTON_STEP);
         for s in step[..segments].iter_mut() {
@@ -442,29 +381,100 @@ pub fn newton_twist<P: Precision, const N: usize>(
             }
         }
         let largest = line_search(frames, rest, terms, &step[..segments], theta);
-        outcome.converged = largest <= tolerance;
-        if outcome.converged && !fixed_cost {
+        outcome.converged = largest <= settings.tolerance;
+        if outcome.converged && !settings.fixed_cost {
             break;
         }
     }
     outcome
 }
 
+/// The Newton twist's iteration cap and tolerance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSettings<R> {
+    /// Most iterations.
+    pub iterations: u16,
+    /// Stop when the largest angle update is at most this, rad (unless `fixed_cost`).
+    pub tolerance: R,
+    /// Always run `iterations` (bounded latency).
+    pub fixed_cost: bool,
+}
+
+/// The Newton system of the twist at some `θ` ([`twist_newton_system`]): the gradient
+/// `∂E/∂θ^j`, the Hessian diagonal in full and Gauss–Newton, and the coupling `H_{j−1,j}`
+/// (stored at `j`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewtonSystem<R, const N: usize> {
+    /// `∂E/∂θ^j`.
+    pub gradient: [R; N],
+    /// `H_jj`.
+    pub full: [R; N],
+    /// `H_jj` without the `−ωᵀB(ω − ω̂)` term.
+    pub gauss_newton: [R; N],
+    /// `H_{j−1,j}`, at `j`.
+    pub coupling: [R; N],
+}
+
+impl<R: Scalar, const N: usize> Default for NewtonSystem<R, N> {
+    fn default() -> Self {
+        NewtonSystem {
+            gradient: [R::ZERO; N],
+            full: [R::ZERO; N],
+            gauss_newton: [R::ZERO; N],
+            coupling: [R::ZERO; N],
+        }
+    }
+}
+
+impl<R: Scalar, const N: usize> NewtonSystem<R, N> {
+    /// The Newton step `s` of `H s = g` over the first `segments` rows (`pivots` as scratch).
+    /// Where the full Hessian is not positive definite, the Gauss–Newton one instead: positive
+    /// definite whenever `β > 0`, once its non-positive entries are floored. Returns whether
+    /// the full Hessian served.
+    fn solve(&mut self, segments: usize, pivots: &mut [R; N], step: &mut [R; N]) -> bool {
+        let rows = ..segments;
+        if solve_tridiagonal(
+            &self.full[rows],
+            &self.coupling[rows],
+            &self.gradient[rows],
+            &mut pivots[rows],
+            &mut step[rows],
+        ) {
+            return true;
+        }
+        for g in self.gauss_newton[rows].iter_mut() {
+            if *g <= R::ZERO || !g.is_finite() {
+                *g = R::of(1.0e-30);
+            }
+        }
+        solve_tridiagonal(
+            &self.gauss_newton[rows],
+            &self.coupling[rows],
+            &self.gradient[rows],
+            &mut pivots[rows],
+            &mut step[rows],
+        );
+        false
+    }
+}
+
 /// The Newton system of the twist at `theta`: gradient `∂E/∂θ^j`, Hessian diagonal (full and
 /// Gauss–Newton) and the coupling `H_{j−1,j}` (stored at `j`). Clamped rows are identity rows
 /// with zero gradient and no coupling.
-#[allow(clippy::too_many_arguments)]
 pub fn twist_newton_system<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     clamped: &ClampedSegments,
     terms: ElasticTerms,
     theta: &[P::R],
-    gradient: &mut [P::R; N],
-    full: &mut [P::R; N],
-    gauss_newton: &mut [P::R; N],
-    coupling: &mut [P::R; N],
+    system: &mut NewtonSystem<P::R, N>,
 ) {
+    let NewtonSystem {
+        gradient,
+        full,
+        gauss_newton,
+        coupling,
+    } = system;
     let n = frames.interior().min(theta.len().saturating_sub(1));
     let two_beta = P::R::of(2.0) * twist_stiffness(rest, terms);
     let cos_sin = material_angles::<P, N>(theta);
@@ -556,7 +566,7 @@ pub fn solve_tridiagonal<R: Scalar>(
 
 /// The material vectors `m1^c` of the clamped segments other than the root, saved before a
 /// step so that afterwards each moves by the time-parallel transport from its old tangent to
-/// its new one (DESIGN.md: `θ^c ← θ^c − ΔΨ^c`): a held segment's frame does not spin about
+/// its new one (`θ^c ← θ^c − ΔΨ^c`, `docs/architecture.md`): a held segment's frame does not spin about
 /// its own axis when the strand bends around it.
 #[derive(Clone, Copy, Debug)]
 pub struct ClampedFrames<P: Precision> {
@@ -621,6 +631,7 @@ mod tests {
     use crate::precision::F64;
     use crate::rod::energy::elastic_energy;
     use crate::rod::energy::tests::{rest_points, Rng, Shape, NODES};
+    use crate::rod::frames::{BINORMAL_FADE, BINORMAL_MIN_WEIGHT};
     use glam::DVec3;
 
     type Rest = RodRest<NODES, f64>;
@@ -635,7 +646,7 @@ mod tests {
             *p += DVec3::new(rng.next(), rng.next(), rng.next()) * amplitude;
         }
         let t0 = (points[1] - points[0]).normalize();
-        let u0 = crate::frames::perpendicular_unit::<F64>(t0);
+        let u0 = crate::frames::perpendicular_unit_by_reciprocal::<F64>(t0);
         let u0 = transport_in_time::<F64>(t0, (x[1] - x[0]).normalize(), u0);
         let frames = RodFrames::<F64, NODES>::compute(&x, u0, &rest.rest_length);
         let clamped = ClampedSegments::ROOT_ONLY;
@@ -653,9 +664,11 @@ mod tests {
             &rest,
             &clamped,
             ElasticTerms::ALL,
-            100,
-            1e-13,
-            false,
+            NewtonSettings {
+                iterations: 100,
+                tolerance: 1e-13,
+                fixed_cost: false,
+            },
             &mut newton[..NODES - 1],
         );
         assert!(outcome.converged, "{outcome:?}");

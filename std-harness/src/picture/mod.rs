@@ -38,6 +38,12 @@ pub enum PictureError {
     Gif(#[from] gif::EncodingError),
 }
 
+impl From<PictureError> for crate::export::ExportError {
+    fn from(e: PictureError) -> Self {
+        crate::export::ExportError::Picture(Box::new(e))
+    }
+}
+
 /// Largest picture side: GIF stores sizes in 16 bits, and this keeps a frame's buffer sane.
 pub const MAX_SIDE: u32 = 8192;
 

@@ -194,3 +194,9 @@ fn gif_frames_decode_back() {
     }
     assert_eq!(frames, 3);
 }
+
+#[test]
+fn views_parse_from_their_names() {
+    assert_eq!("Side".parse::<View>(), Ok(View::Side));
+    assert!("diagonal".parse::<View>().is_err());
+}

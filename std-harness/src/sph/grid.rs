@@ -13,8 +13,8 @@
 //! Why a raster and not a hash of the cell, as the paper's (and Teschner et al. 2003's)
 //! spatial hash: the nine rows around a particle are then its own, the ones beside it along y,
 //! and those one slab away along z, so a pass over the sorted particles reads a band about
-//! three slabs deep, which stays in the core's own cache. Session 5's rows were placed by a
-//! hash in bricks of 4 × 4: most particles read rows from several bricks at random places,
+//! three slabs deep, which stays in the core's own cache. An earlier version placed the rows by
+//! a hash in bricks of 4 × 4: most particles read rows from several bricks at random places,
 //! and the neighbour pass waited on memory (Mannequin A's neighbour search 42–44 → 32 ms on
 //! one thread, the stage bench, old and new binary alternately).
 

@@ -13,7 +13,7 @@
 //! loaded once and tested for both. What costs here is cache misses and mispredicted branches
 //! more than instructions: valgrind's branch simulation (the whole pass, 7 SPH steps of
 //! Mannequin A, `--toggle-collect='*NeighbourLists*build*'`) counts 11.7 M mispredictions and
-//! 4.50 G instructions in session 5's pass, 8.5 M and 3.87 G now (the kept density term
+//! 4.50 G instructions in the earlier pass, 8.5 M and 3.87 G now (the kept density term
 //! without a branch took 2.4 M of the mispredictions; the byte masks and the pairs took the
 //! instructions, and no time that could be measured), and the raster grid ([`super::grid`])
 //! took about 40 % off the pass's time by keeping the rows it reads in cache. The first `cap`
@@ -25,11 +25,12 @@
 //! its own part of the storage, so the few neighbours a particle has (about five on a head)
 //! take a few bytes, not a cache line and a half of room for `cap` of them.
 
+#![deny(clippy::too_many_lines, clippy::too_many_arguments)]
 use hairsim_core::Vec3;
 use rayon::prelude::*;
 
 use super::forces::{poly6_factor, SortedParticles};
-use super::grid::{cell_of, Grid, RowsAround, MAX_RANGES};
+use super::grid::{cell_of, Grid, Layout, RowsAround, MAX_RANGES};
 use super::{SphParams, CHUNK, MAX_CAP};
 
 /// Entries past the last particle in the position arrays: a range is tested in pieces of
@@ -100,12 +101,6 @@ impl NeighbourLists {
     pub fn build(&mut self, grid: &Grid, p: &mut SortedParticles, params: &SphParams) -> Found {
         let cap = self.cap;
         let n = p.mass.len();
-        let h = params.smoothing_length;
-        let h2 = h * h;
-        let c6 = poly6_factor(h);
-        let (stiffness, rest) = (params.stiffness, params.rest_density);
-        let gap = params.same_strand_gap;
-        let (inverse_cell, layout) = (grid.inverse_cell(), grid.layout());
         let SortedParticles {
             x,
             y,
@@ -117,8 +112,27 @@ impl NeighbourLists {
             packed,
             ..
         } = p;
-        let (x, y, z, mass, key, velocity) =
-            (&x[..], &y[..], &z[..], &mass[..], &key[..], &velocity[..]);
+        let h = params.smoothing_length;
+        let h2 = h * h;
+        let search = Search {
+            x,
+            y,
+            z,
+            velocity,
+            near: Near {
+                key,
+                mass,
+                cap,
+                gap: params.same_strand_gap,
+                h2,
+            },
+            grid,
+            inverse_cell: grid.inverse_cell(),
+            layout: grid.layout(),
+            c6: poly6_factor(h),
+            stiffness: params.stiffness,
+            rest: params.rest_density,
+        };
         self.list
             .par_chunks_mut(CHUNK * cap + 1)
             .zip(self.start[..n].par_chunks_mut(CHUNK))
@@ -127,108 +141,204 @@ impl NeighbourLists {
             .zip(packed.par_chunks_mut(CHUNK))
             .enumerate()
             .map(|(c, ((((list, start), count), density), packed))| {
-                let mut found = Found::default();
-                let mut rows = RowsAround::NONE;
-                let mut ranges = [(0u32, 0u32); MAX_RANGES];
-                // The cell whose 27 cells `ranges` holds: sorted particles of one cell are
-                // consecutive and share them.
-                let mut ranged: Option<([i32; 3], usize)> = None;
-                let mut used = 0usize;
-                // The second particle of a pair gathers its list here; it is moved next to
-                // the first one's once that one's length is known.
-                let mut spare = [0u32; MAX_CAP + 1];
-                let record_len = count.len();
-                let mut record = |k: usize, a: usize, me: [f32; 3], list: &Gathered| {
-                    start[k] = (c * (CHUNK * cap + 1) + list.at) as u32;
-                    count[k] = list.kept as u32;
-                    found.kept += list.kept as u64;
-                    found.truncated += u64::from(list.all) - list.kept as u64;
-                    found.max_found = found.max_found.max(list.all);
-                    let rho = c6 * list.sum;
-                    let pr = (stiffness * (rho - rest)).max(0.0);
-                    density[k] = rho;
-                    let [vx, vy, vz] = velocity[a];
-                    packed[k] = [me[0], me[1], me[2], mass[a] / rho, vx, vy, vz, pr];
+                let mut chunk = Chunk {
+                    c,
+                    list,
+                    start,
+                    count,
+                    density,
+                    packed,
+                    found: Found::default(),
                 };
-                let near = Near {
-                    key,
-                    mass,
-                    cap,
-                    gap,
-                    h2,
-                };
-                let cell_at = |a: usize| cell_of(Vec3::new(x[a], y[a], z[a]), inverse_cell);
-                // Particle `k`'s cell when the previous pass looked it up already.
-                let mut known = None;
-                let mut k = 0;
-                // Bounded: `k` moves on by one or two a pass.
-                while k < record_len {
-                    let a = c * CHUNK + k;
-                    let me = [x[a], y[a], z[a]];
-                    let cell = known.unwrap_or_else(|| cell_at(a));
-                    rows.update(cell, layout);
-                    let m = match ranged {
-                        Some((of, m)) if of == cell => m,
-                        _ => {
-                            let m = rows.ranges(grid, cell, &mut ranges);
-                            ranged = Some((cell, m));
-                            m
-                        }
-                    };
-                    // The next particle, if it is in the same cell: the two share one pass
-                    // over their ranges (the loads, the range and piece bookkeeping).
-                    let b = a + 1;
-                    let next = (k + 1 < record_len).then(|| cell_at(b));
-                    let pair = (next == Some(cell)).then(|| [x[b], y[b], z[b]]);
-                    known = if pair.is_some() { None } else { next };
-                    let mut one = Gather::new(a, key[a], mass[a] * h2 * h2 * h2, used);
-                    let mine = &mut list[used..used + cap + 1];
-                    let two = match pair {
-                        Some(other) => {
-                            let mut two = Gather::new(b, key[b], mass[b] * h2 * h2 * h2, 0);
-                            let theirs = &mut spare[..cap + 1];
-                            test_ranges(
-                                &ranges[..m],
-                                (x, y, z),
-                                ([a, b], [me, other]),
-                                h2,
-                                &mut |p, j, d2| {
-                                    if p == 0 {
-                                        one.hit(j, d2, &near, mine);
-                                    } else {
-                                        two.hit(j, d2, &near, theirs);
-                                    }
-                                },
-                            );
-                            Some(two.done())
-                        }
-                        None => {
-                            test_ranges(
-                                &ranges[..m],
-                                (x, y, z),
-                                ([a], [me]),
-                                h2,
-                                &mut |_, j, d2| {
-                                    one.hit(j, d2, &near, mine);
-                                },
-                            );
-                            None
-                        }
-                    };
-                    let one = one.done();
-                    record(k, a, me, &one);
-                    used += one.kept;
-                    if let (Some(mut two), Some(other)) = (two, pair) {
-                        list[used..used + two.kept].copy_from_slice(&spare[..two.kept]);
-                        two.at = used;
-                        record(k + 1, b, other, &two);
-                        used += two.kept;
-                    }
-                    k += 1 + usize::from(pair.is_some());
-                }
-                found
+                search.chunk(&mut chunk);
+                chunk.found
             })
             .reduce(Found::default, Found::merge)
+    }
+}
+
+/// What every chunk's search reads: the sorted particles, the grid, and the parameters as
+/// the search uses them.
+struct Search<'a> {
+    x: &'a [f32],
+    y: &'a [f32],
+    z: &'a [f32],
+    velocity: &'a [[f32; 3]],
+    /// The sorted keys and masses, the cap, the same-strand gap and `h²`.
+    near: Near<'a>,
+    grid: &'a Grid,
+    inverse_cell: f32,
+    layout: Layout,
+    /// The poly6 kernel's factor.
+    c6: f32,
+    stiffness: f32,
+    /// Rest density.
+    rest: f32,
+}
+
+/// One chunk of particles: what its search writes, and its counts.
+struct Chunk<'a> {
+    /// The chunk's index.
+    c: usize,
+    /// The chunk's part of the list storage.
+    list: &'a mut [u32],
+    start: &'a mut [u32],
+    count: &'a mut [u32],
+    density: &'a mut [f32],
+    packed: &'a mut [[f32; 8]],
+    found: Found,
+}
+
+/// A particle of a chunk (sorted `a`, at `me`) and, when the next one is in the same cell,
+/// that one's position: the two take their lists in one pass.
+struct Particles {
+    a: usize,
+    me: [f32; 3],
+    pair: Option<[f32; 3]>,
+}
+
+/// The 27 cells around the particles' cell, as ranges of sorted particles: the rows around
+/// it follow every particle; the ranges are looked up again only when the cell changes.
+struct CellRanges {
+    rows: RowsAround,
+    ranges: [(u32, u32); MAX_RANGES],
+    /// The cell whose 27 cells `ranges` holds, and how many ranges: sorted particles of one
+    /// cell are consecutive and share them.
+    ranged: Option<([i32; 3], usize)>,
+}
+
+impl CellRanges {
+    /// The ranges around `cell`.
+    #[inline(always)]
+    fn around(&mut self, grid: &Grid, cell: [i32; 3], layout: Layout) -> &[(u32, u32)] {
+        self.rows.update(cell, layout);
+        let m = match self.ranged {
+            Some((of, m)) if of == cell => m,
+            _ => {
+                let m = self.rows.ranges(grid, cell, &mut self.ranges);
+                self.ranged = Some((cell, m));
+                m
+            }
+        };
+        &self.ranges[..m]
+    }
+}
+
+impl Search<'_> {
+    /// Sorted particle `a`'s position.
+    #[inline(always)]
+    fn at(&self, a: usize) -> [f32; 3] {
+        [self.x[a], self.y[a], self.z[a]]
+    }
+
+    /// Sorted particle `a`'s cell.
+    #[inline(always)]
+    fn cell_at(&self, a: usize) -> [i32; 3] {
+        cell_of(
+            Vec3::new(self.x[a], self.y[a], self.z[a]),
+            self.inverse_cell,
+        )
+    }
+
+    /// Every list of chunk `chunk.c`, one particle after another, or two at once when the
+    /// next particle is in the same cell.
+    #[inline(always)]
+    fn chunk(&self, chunk: &mut Chunk<'_>) {
+        let cap = self.near.cap;
+        let mut cells = CellRanges {
+            rows: RowsAround::NONE,
+            ranges: [(0u32, 0u32); MAX_RANGES],
+            ranged: None,
+        };
+        let mut used = 0usize;
+        // The second particle of a pair gathers its list here; it is moved next to the first
+        // one's once that one's length is known.
+        let mut spare = [0u32; MAX_CAP + 1];
+        let record_len = chunk.count.len();
+        // Particle `k`'s cell when the previous pass looked it up already.
+        let mut known = None;
+        let mut k = 0;
+        // Bounded: `k` moves on by one or two a pass.
+        while k < record_len {
+            let a = chunk.c * CHUNK + k;
+            let me = self.at(a);
+            let cell = known.unwrap_or_else(|| self.cell_at(a));
+            let ranges = cells.around(self.grid, cell, self.layout);
+            // The next particle, if it is in the same cell: the two share one pass over
+            // their ranges (the loads, the range and piece bookkeeping).
+            let b = a + 1;
+            let next = (k + 1 < record_len).then(|| self.cell_at(b));
+            let pair = (next == Some(cell)).then(|| self.at(b));
+            known = if pair.is_some() { None } else { next };
+            let mine = &mut chunk.list[used..used + cap + 1];
+            let particles = Particles { a, me, pair };
+            let (one, two) = self.gather(ranges, &particles, used, mine, &mut spare[..cap + 1]);
+            self.record(chunk, k, a, me, &one);
+            used += one.kept;
+            if let (Some(mut two), Some(other)) = (two, pair) {
+                chunk.list[used..used + two.kept].copy_from_slice(&spare[..two.kept]);
+                two.at = used;
+                self.record(chunk, k + 1, b, other, &two);
+                used += two.kept;
+            }
+            k += 1 + usize::from(pair.is_some());
+        }
+    }
+
+    /// The lists of particle `p.a` (into `mine`, which starts at `used` in the chunk's
+    /// storage) and, with `p.pair`, of particle `p.a + 1` (into `theirs`), in one pass over
+    /// `ranges`.
+    #[inline(always)]
+    fn gather(
+        &self,
+        ranges: &[(u32, u32)],
+        p: &Particles,
+        used: usize,
+        mine: &mut [u32],
+        theirs: &mut [u32],
+    ) -> (Gathered, Option<Gathered>) {
+        let (key, mass, h2) = (self.near.key, self.near.mass, self.near.h2);
+        let (a, me, near) = (p.a, p.me, &self.near);
+        let xyz = (self.x, self.y, self.z);
+        let mut one = Gather::new(a, key[a], mass[a] * h2 * h2 * h2, used);
+        match p.pair {
+            Some(other) => {
+                let b = a + 1;
+                let mut two = Gather::new(b, key[b], mass[b] * h2 * h2 * h2, 0);
+                test_ranges(ranges, xyz, ([a, b], [me, other]), h2, &mut |p, j, d2| {
+                    if p == 0 {
+                        one.hit(j, d2, near, mine);
+                    } else {
+                        two.hit(j, d2, near, theirs);
+                    }
+                });
+                (one.done(), Some(two.done()))
+            }
+            None => {
+                test_ranges(ranges, xyz, ([a], [me]), h2, &mut |_, j, d2| {
+                    one.hit(j, d2, near, mine);
+                });
+                (one.done(), None)
+            }
+        }
+    }
+
+    /// Writes particle `k` of the chunk (sorted `a`, at `me`): where its list starts, its
+    /// count, its density, and its force inputs with the pressure.
+    #[inline(always)]
+    fn record(&self, chunk: &mut Chunk<'_>, k: usize, a: usize, me: [f32; 3], list: &Gathered) {
+        let cap = self.near.cap;
+        let found = &mut chunk.found;
+        chunk.start[k] = (chunk.c * (CHUNK * cap + 1) + list.at) as u32;
+        chunk.count[k] = list.kept as u32;
+        found.kept += list.kept as u64;
+        found.truncated += u64::from(list.all) - list.kept as u64;
+        found.max_found = found.max_found.max(list.all);
+        let rho = self.c6 * list.sum;
+        let pr = (self.stiffness * (rho - self.rest)).max(0.0);
+        chunk.density[k] = rho;
+        let [vx, vy, vz] = self.velocity[a];
+        chunk.packed[k] = [me[0], me[1], me[2], self.near.mass[a] / rho, vx, vy, vz, pr];
     }
 }
 

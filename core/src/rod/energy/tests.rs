@@ -4,13 +4,15 @@
 //!
 //! The reference energies are built from the frames alone, independently of the gradient
 //! code: the root frame moves by time-parallel transport, a clamped segment's material vector
-//! likewise (DESIGN.md), free angles are either held (hair-optimised twist: `F = −∂E/∂x` at
-//! fixed `θ`) or re-minimised by Newton (`F = −dE/dx`).
+//! likewise (docs/architecture.md), free angles are either held (hair-optimised twist:
+//! `F = −∂E/∂x` at fixed `θ`) or re-minimised by Newton (`F = −dE/dx`).
 
 use super::*;
 use crate::frames::transport_in_time;
 use crate::precision::F64;
-use crate::rod::twist::{newton_twist, twist_newton_system, ClampedFrames};
+use crate::rod::twist::{
+    newton_twist, twist_newton_system, ClampedFrames, NewtonSettings, NewtonSystem,
+};
 use glam::DVec3;
 
 pub(crate) const NODES: usize = 12;
@@ -76,7 +78,7 @@ fn rest_config(points: &[DVec3; NODES], rest: &Rest) -> Config {
     Config {
         x: *points,
         theta: rest.rest_theta,
-        u0: crate::frames::perpendicular_unit::<F64>(root_tangent(points)),
+        u0: crate::frames::perpendicular_unit_by_reciprocal::<F64>(root_tangent(points)),
     }
 }
 
@@ -114,9 +116,11 @@ fn energy_at(
             rest,
             clamped,
             ElasticTerms::ALL,
-            60,
-            1e-14,
-            false,
+            NewtonSettings {
+                iterations: 60,
+                tolerance: 1e-14,
+                fixed_cost: false,
+            },
             &mut theta,
         );
     }
@@ -208,9 +212,11 @@ fn forces_are_minus_the_total_gradient_with_the_newton_twist() {
                         &rest,
                         &clamped,
                         ElasticTerms::ALL,
-                        60,
-                        1e-14,
-                        false,
+                        NewtonSettings {
+                            iterations: 60,
+                            tolerance: 1e-14,
+                            fixed_cost: false,
+                        },
                         &mut c.theta,
                     );
                     assert!(outcome.converged, "{outcome:?}");
@@ -238,23 +244,10 @@ fn twist_derivative_and_newton_hessian_match_finite_differences() {
             let f = frames(&c.x, c.u0, &rest);
             let energy = |theta: &[f64; NODES]| elastic_energy(&f, theta, &rest, ElasticTerms::ALL);
             let system = |theta: &[f64; NODES]| {
-                let mut g = [0.0; NODES];
-                let mut full = [0.0; NODES];
-                let mut gn = [0.0; NODES];
-                let mut coupling = [0.0; NODES];
+                let mut system = NewtonSystem::<f64, NODES>::default();
                 let t = &theta[..NODES - 1];
-                twist_newton_system(
-                    &f,
-                    &rest,
-                    &clamped,
-                    ElasticTerms::ALL,
-                    t,
-                    &mut g,
-                    &mut full,
-                    &mut gn,
-                    &mut coupling,
-                );
-                (g, full, coupling)
+                twist_newton_system(&f, &rest, &clamped, ElasticTerms::ALL, t, &mut system);
+                (system.gradient, system.full, system.coupling)
             };
             let h = 1e-6;
             let (g, full, coupling) = system(&c.theta);
@@ -343,9 +336,11 @@ fn rest_shapes_have_no_energy_and_no_force_under_both_twists() {
                 &rest,
                 &clamped,
                 ElasticTerms::ALL,
-                10,
-                1e-12,
-                false,
+                NewtonSettings {
+                    iterations: 10,
+                    tolerance: 1e-12,
+                    fixed_cost: false,
+                },
                 &mut theta,
             );
             for (a, b) in theta.iter().zip(&c.theta) {

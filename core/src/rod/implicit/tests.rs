@@ -8,8 +8,9 @@ extern crate std;
 use super::*;
 use crate::math::Libm;
 use crate::precision::F64;
-use crate::rod::energy::{elastic_forces, RodFrames, RodRest};
+use crate::rod::energy::{elastic_forces, RodFrames};
 use crate::rod::{ClampedSegments, ElasticTerms};
+use crate::strand::RodRest;
 use crate::strand::{Material, Strand};
 use glam::DVec3;
 use std::println;
@@ -200,6 +201,52 @@ fn on_a_straight_strand_the_matrix_is_the_hessian_of_the_forces() {
     assert!(worst < 1e-4 * scale, "{worst:e} of {scale:e}");
 }
 
+/// `points` moved by `amplitude` per coordinate (pseudo-randomly, by `seed`), then each
+/// segment brought back to its rest length from the root (follow the leader): the projection
+/// keeps the strand inextensible, so only such states occur.
+fn moved_at_rest_lengths(
+    points: &[Vec3],
+    strand: &Strand<NODES>,
+    amplitude: f32,
+    seed: u32,
+) -> Vec<Vec3> {
+    let mut x = points.to_vec();
+    for (i, p) in x.iter_mut().enumerate().skip(2) {
+        let k = (i as u32 * 7 + seed * 13) as f32;
+        *p += Vec3::new(k.sin(), (1.3 * k).cos(), (0.7 * k).sin()) * amplitude;
+    }
+    for i in 2..NODES {
+        let e = x[i] - x[i - 1];
+        x[i] = x[i - 1] + e * (strand.rest.segment_length[i - 1] / e.length());
+    }
+    x
+}
+
+/// `4M + 2t(A − M) − h²H` for the assembled matrix `A` and the Hessian `H` of the explicit
+/// forces: positive definite when the step with `H̃` scaled by `t` is stable on every mode.
+fn stability_margin(
+    strand: &Strand<NODES>,
+    a: &[Vec<f64>],
+    hessian: &[Vec<f64>],
+    t: f64,
+) -> Vec<Vec<f64>> {
+    let h2 = DT * DT;
+    (0..3 * NODES)
+        .map(|r| {
+            (0..3 * NODES)
+                .map(|c| {
+                    let m = if r == c {
+                        f64::from(strand.rest.mass[r / 3])
+                    } else {
+                        0.0
+                    };
+                    4.0 * m + t * 2.0 * (a[r][c] - m) - h2 * hessian[r][c]
+                })
+                .collect()
+        })
+        .collect()
+}
+
 #[test]
 fn the_step_is_stable_where_the_explicit_one_is_not() {
     // Linearised backward Euler with the approximate Hessian H̃ is stable for a mode while
@@ -210,7 +257,6 @@ fn the_step_is_stable_where_the_explicit_one_is_not() {
     // ×1000 (1 cm segments), and a 2 mm curl of human hair, for which the elastic step alone
     // needs H̃ × 1.25 (HOLONOMY_SHARE; measured ≤ 1.25, asserted ≤ 1.6) — the whole step,
     // projection included, is stable on it (tests/torture.rs).
-    let h2 = DT * DT;
     let moves = [
         (0.0f32, 0u32),
         (1.0e-4, 1),
@@ -226,35 +272,10 @@ fn the_step_is_stable_where_the_explicit_one_is_not() {
             }
             let strand = Strand::<NODES>::from_polyline(&points, &material).unwrap();
             for (amplitude, seed) in moves {
-                let mut x = points.clone();
-                for (i, p) in x.iter_mut().enumerate().skip(2) {
-                    let k = (i as u32 * 7 + seed * 13) as f32;
-                    *p += Vec3::new(k.sin(), (1.3 * k).cos(), (0.7 * k).sin()) * amplitude;
-                }
-                // Segment lengths back to rest from the root (follow the leader): the
-                // projection keeps the strand inextensible, so only such states occur.
-                for i in 2..NODES {
-                    let e = x[i] - x[i - 1];
-                    x[i] = x[i - 1] + e * (strand.rest.segment_length[i - 1] / e.length());
-                }
+                let x = moved_at_rest_lengths(&points, &strand, amplitude, seed);
                 let a = dense(&system_at(&strand, &x, false));
                 let hessian = force_hessian(&points, &x, &material, strand.state.root_frame);
-                let margin = |t: f64| -> Vec<Vec<f64>> {
-                    (0..3 * NODES)
-                        .map(|r| {
-                            (0..3 * NODES)
-                                .map(|c| {
-                                    let m = if r == c {
-                                        f64::from(strand.rest.mass[r / 3])
-                                    } else {
-                                        0.0
-                                    };
-                                    4.0 * m + t * 2.0 * (a[r][c] - m) - h2 * hessian[r][c]
-                                })
-                                .collect()
-                        })
-                        .collect()
-                };
+                let margin = |t: f64| stability_margin(&strand, &a, &hessian, t);
                 let explicit_stable = positive_definite(&margin(0.0));
                 let mut needed = 1.0;
                 while !positive_definite(&margin(needed)) && needed < 1e4 {

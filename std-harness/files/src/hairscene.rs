@@ -21,8 +21,16 @@ use std::path::Path;
 
 use hairsim_core::Vec3;
 
-use crate::run::HairFileOptions;
 use crate::scene::{ColliderSpec, FieldError, FileSpec, HairSpec, Scene, FORMAT};
+
+/// Options for a hair file given as the scene (`hairsim run head.hair`).
+#[derive(Clone, Debug, Default)]
+pub struct HairFileOptions {
+    /// Factor from the file's units to metres.
+    pub scale: Option<f32>,
+    /// The file's up axis, `y` or `z`.
+    pub up: Option<String>,
+}
 
 /// Strands the default scene keeps at most, picked evenly through the file.
 pub const DEFAULT_MAX_STRANDS: u32 = 1000;

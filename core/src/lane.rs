@@ -1,7 +1,7 @@
-//! Lanes: the arithmetic every DFTL stage is written in, generic over a lane type `T` so the
-//! per-strand path (`T = Real`) and the block path (`T = Wide<W>`, one strand per lane) run
-//! the very same sequence of IEEE operations on each strand — the same bits by construction
-//! (Box2D's `b2FloatW` with its scalar fallback).
+//! Lanes: the arithmetic the DFTL stages and the shared root coupling and guard are written
+//! in, generic over a lane type `T` so the per-strand path (`T = Real`) and the block path
+//! (`T = Wide<W>`, one strand per lane) run the very same sequence of IEEE operations on each
+//! strand — the same bits by construction (Box2D's `b2FloatW` with its scalar fallback).
 //!
 //! Every operation on [`Wide`] is a loop over its `W` lanes with no cross-lane term, which the
 //! compiler turns into packed instructions; nothing ever sums across lanes. Comparisons give a
@@ -24,6 +24,7 @@ pub trait Lane:
 {
     /// One boolean per lane.
     type Mask: Copy
+        + core::fmt::Debug
         + BitAnd<Output = Self::Mask>
         + BitOr<Output = Self::Mask>
         + Not<Output = Self::Mask>;
@@ -419,6 +420,20 @@ impl From<Q<Real>> for Quat {
     fn from(q: Q<Real>) -> Self {
         Quat::from_xyzw(q.x, q.y, q.z, q.w)
     }
+}
+
+/// 0 where every component of `v` is finite, NaN otherwise (`x − x`): summed over the
+/// velocities a step writes, it is the whole verdict of the DFTL guard.
+///
+/// Velocities only: a node's new velocity is `(x* − x)/Δt − (s_d/Δt) c` (or
+/// `(target − x)/Δt` for a held node), and with `x` finite (the last step's guard saw to
+/// that) and `1/Δt` finite and positive, a non-finite `x*` makes it non-finite too (`±∞` stays
+/// `±∞` or meets `∓∞` and turns NaN; NaN stays NaN) — so the positions need no check of their
+/// own, and a non-finite old `x` is caught the same way. DFTL writes no twist.
+#[inline(always)]
+#[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
+pub fn not_finite<T: Lane>(v: V3<T>) -> T {
+    (v.x - v.x) + (v.y - v.y) + (v.z - v.z)
 }
 
 #[cfg(test)]

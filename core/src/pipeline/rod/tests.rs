@@ -1,15 +1,18 @@
-//! The rod step with the elastic stages on: rest shapes stay at rest, stiff hair stays stable.
+//! The rod's pipeline with the elastic stages on: rest shapes stay at rest, stiff hair stays
+//! stable.
 //!
 //! The stiff-hair tests run with the fast manifold projection (`inextensibility`). (A test-only
 //! Gauss–Seidel length restoration with `v += Δx/h`, used before the projection existed, itself
 //! pumped energy into a whipped ×100 strand with µ = 1.5 and made it blow up.)
 
 use super::*;
-use crate::effects::Effects;
+use crate::effects::{Effect, Effects};
 use crate::head::{Pose, Shake};
 use crate::math::Libm;
 use crate::params::Params;
+use crate::params::TwistMethod;
 use crate::report::Flags;
+use crate::rod::substeps::*;
 use crate::strand::Material;
 use crate::world::{StepInput, World};
 
@@ -213,7 +216,7 @@ fn smallest_binormal_denominator_is_one_plus_cos_of_the_sharpest_turn() {
     }
     let s = Strand::<NODES>::from_polyline(&points[..4], &Material::HUMAN_HAIR).unwrap();
     let mut frames = RodFrames::<Libm, NODES>::empty();
-    refresh_frames(&mut frames, &s);
+    frames.refresh(&s);
     let g = smallest_binormal_denominator(&frames, &s.rest.rod.rest_length);
     assert!((g - (1.0 + libm::cosf(1.9))).abs() < 1e-5, "{g}");
 }

@@ -1,5 +1,5 @@
-//! Scene files, format 1 (DESIGN.md "Scene file, format 1"; documented in full with a
-//! commented example in `docs/scene-format.md`).
+//! Scene files, format 1 (documented in full with a commented example in
+//! `docs/scene-format.md`).
 //!
 //! One structure for everything: a TOML file deserialises into [`Scene`], the built-in scenes
 //! are [`Scene`] values written in Rust (`crate::builtin`), and a recording stores the scene as
@@ -50,7 +50,7 @@ pub struct Scene {
     /// Simulated time, s (or give `steps`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub duration: Option<f32>,
-    /// The effects that run, by DESIGN.md's names; nothing else runs.
+    /// The effects that run, by the names `docs/scene-format.md` lists; nothing else runs.
     pub effects: Vec<String>,
     /// `"converge"` (default) or `"fixed-cost"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -480,7 +480,7 @@ pub struct WindSpec {
     pub seed: Option<u32>,
 }
 
-/// `[hair-hair]`: SPH parameters (DESIGN.md "SPH hair–hair interaction"); defaults are
+/// `[hair-hair]`: SPH parameters (`docs/scene-format.md`, "[hair-hair]"); defaults are
 /// the SPH module's.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

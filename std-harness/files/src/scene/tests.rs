@@ -754,7 +754,7 @@ fn builtin_errors_name_the_builtin() {
 /// replaced by an extreme: a scene or one placed error every time, never a panic.
 #[test]
 fn mangled_scenes_give_errors_not_panics() {
-    let doc = include_str!("../../../docs/scene-format.md");
+    let doc = include_str!("../../../../docs/scene-format.md");
     let start = doc.find("```toml\n").unwrap() + "```toml\n".len();
     let example = &doc[start..start + doc[start..].find("```").unwrap()];
     let lines: Vec<&str> = example.lines().collect();

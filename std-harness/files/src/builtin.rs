@@ -128,7 +128,7 @@ fn about(name: &str) -> &'static str {
 
 const ROD_EFFECTS: &[&str] = &["gravity", "drag", "bending", "twist", "inextensibility"];
 
-/// DESIGN.md's "shaking at 10 rad/s".
+/// The head shaking at 10 rad/s of Kmoch 2009's Head scenes (`Shake::TEN_RAD_PER_S`).
 fn ten_rad_per_s() -> HeadSpec {
     let s = Shake::TEN_RAD_PER_S;
     HeadSpec {

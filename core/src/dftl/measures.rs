@@ -1,0 +1,180 @@
+//! What a DFTL step measures along its pass, for the report: each segment's strain (stretched
+//! or compressed, with or without a node pushed out of a collider), how deep nodes are left
+//! inside colliders, how many were pushed, and the momentum the colliders gave.
+//!
+//! Segment strain is measured as `(|e|² − l²)/(2l²)` (no square root) and turned into a
+//! relative stretch once per strand ([`Measures::stretches`]).
+
+use crate::capacities::MAX_COLLIDERS;
+use crate::lane::{Lane, V3};
+use crate::math::{Math, Real, Vec3};
+use crate::report::StepReport;
+
+use super::node::NodeInput;
+
+/// What a step measures along the way, per lane: strain extremes, penetration and contacts
+/// (the momentum the colliders gave is kept apart, in a [`ColliderPush`]: these few running
+/// values can then live in registers through the node loop). Nothing is ever summed across
+/// lanes; sums run along each strand in node order in both paths, so they are the same bits.
+#[derive(Clone, Copy, Debug)]
+pub struct Measures<T> {
+    /// Largest strain `(|e|² − l²)/(2 l²)` of a segment without contact (≥ 0).
+    pub stretched: T,
+    /// Largest `−strain` of a segment without contact (≥ 0).
+    pub compressed: T,
+    /// Largest strain of a segment with a pushed node.
+    pub contact_stretched: T,
+    /// Largest `−strain` of a segment with a pushed node.
+    pub contact_compressed: T,
+    /// Deepest node left inside a collider.
+    pub penetration: T,
+    /// Nodes pushed out.
+    pub contacts: T,
+}
+
+/// `Σ m Δx^push` per collider (the push-outs, mass weighted), per lane.
+pub type ColliderPush<T> = [V3<T>; MAX_COLLIDERS];
+
+impl<T: Lane> Default for Measures<T> {
+    fn default() -> Self {
+        let zero = T::splat(0.0);
+        Measures {
+            stretched: zero,
+            compressed: zero,
+            contact_stretched: zero,
+            contact_compressed: zero,
+            penetration: zero,
+            contacts: zero,
+        }
+    }
+}
+
+/// The segment from the final node `i − 1` to node `i`: its edge and squared length, which
+/// the frame update reads next.
+#[derive(Clone, Copy, Debug)]
+pub struct Segment<T> {
+    /// `e = x*_i − x*_{i−1}`.
+    pub edge: V3<T>,
+    /// `|e|²`.
+    pub squared_length: T,
+}
+
+impl<T: Lane> Measures<T> {
+    /// Measures the segment from `previous` to the final `x` of `node`: its strain
+    /// `(|e|² − l²)/(2l²) = δ + δ²/2` for the relative stretch δ (no square root; turned into
+    /// δ once per strand), into the extremes of segments with contact where `touched` (a
+    /// collider pushed this node or the one before) when `collisions`, without otherwise.
+    #[inline(always)]
+    pub fn segment(
+        &mut self,
+        collisions: bool,
+        previous: V3<T>,
+        x: V3<T>,
+        node: &NodeInput<T>,
+        touched: T::Mask,
+    ) -> Segment<T> {
+        let active = node.active;
+        let edge = x - previous;
+        let squared_length = edge.dot(edge);
+        let strain =
+            (squared_length - node.segment_length * node.segment_length) * node.strain_scale;
+        if collisions {
+            let free = active & !touched;
+            if T::all(free) {
+                // The common case, every lane free: the masked form below selects `strain`
+                // for the free extremes and adds a 0 to the (non-negative) contact ones, which
+                // leaves them as they are — the same bits, without the selects.
+                self.stretched = self.stretched.max(strain);
+                self.compressed = self.compressed.max(-strain);
+            } else {
+                let pushed = active & touched;
+                self.stretched = self.stretched.max_where(free, strain);
+                self.compressed = self.compressed.max_where(free, -strain);
+                self.contact_stretched = self.contact_stretched.max_where(pushed, strain);
+                self.contact_compressed = self.contact_compressed.max_where(pushed, -strain);
+            }
+        } else {
+            // No collider, no contact: the contact extremes stay 0 in both forms.
+            self.stretched = self.stretched.max_where(active, strain);
+            self.compressed = self.compressed.max_where(active, -strain);
+        }
+        Segment {
+            edge,
+            squared_length,
+        }
+    }
+
+    /// The largest relative stretch of a segment without and with a pushed node, per lane.
+    #[inline(always)]
+    #[must_use]
+    pub fn stretches<M: Math>(&self) -> (T, T) {
+        (
+            largest_stretch::<M, T>(self.stretched, self.compressed),
+            largest_stretch::<M, T>(self.contact_stretched, self.contact_compressed),
+        )
+    }
+}
+
+/// The relative stretch `δ` of a strain `s = δ + δ²/2`: `δ = 2s / (1 + √(1 + 2s))` (the form
+/// without cancellation for small `s`), on lanes so a block turns all its strands' strains at
+/// once.
+#[inline(always)]
+fn relative_stretch<M: Math, T: Lane>(strain: T) -> T {
+    let (one, two) = (T::splat(1.0), T::splat(2.0));
+    two * strain / (one + (one + two * strain).max(T::splat(0.0)).sqrt::<M>())
+}
+
+/// The largest `|δ|` of the strains between `−down` and `up`: `δ(s)` grows with `s`, so it is
+/// at one end or the other.
+#[inline(always)]
+fn largest_stretch<M: Math, T: Lane>(up: T, down: T) -> T {
+    relative_stretch::<M, T>(up).max(-relative_stretch::<M, T>(-down))
+}
+
+/// What a strand (or a block's lane) tells the report about its segments and contacts.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Tally {
+    /// Largest relative stretch `| |e| − l | / l` of a segment without a pushed node.
+    pub stretch: Real,
+    /// Largest relative stretch of a segment with a pushed node.
+    pub contact_stretch: Real,
+    /// Deepest node left inside a collider.
+    pub penetration: Real,
+    /// Nodes pushed out.
+    pub contacts: u32,
+    /// `Σ m Δx^push` per collider.
+    pub collider_push: [Vec3; MAX_COLLIDERS],
+}
+
+impl Tally {
+    /// One strand's measures as the report gives them (a block builds its lanes' tallies
+    /// from [`Measures::stretches`] of all lanes at once).
+    #[must_use]
+    pub fn from_measures<M: Math>(m: &Measures<Real>, collider_push: &ColliderPush<Real>) -> Self {
+        let (stretch, contact_stretch) = m.stretches::<M>();
+        Tally {
+            stretch,
+            contact_stretch,
+            penetration: m.penetration,
+            contacts: m.contacts as u32,
+            collider_push: collider_push.map(Vec3::from),
+        }
+    }
+
+    /// Folds the tally into `report`: maxima and counts, and each collider's contact force
+    /// `−Σ m Δx^push / Δt²` (the hair's push on the collider, as the rod solver reports it),
+    /// added strand by strand in strand order, for the scene's first `colliders` colliders (0
+    /// with collisions off; the others have no push to add).
+    pub fn report(&self, report: &mut StepReport, colliders: usize, inv_dt: Real) {
+        // `Lane::max`, a compare: `f32::max` is a library call on the Cortex-M4F.
+        report.max_stretch = Lane::max(report.max_stretch, self.stretch);
+        report.max_contact_stretch = Lane::max(report.max_contact_stretch, self.contact_stretch);
+        report.max_penetration = Lane::max(report.max_penetration, self.penetration);
+        report.contacts += self.contacts;
+        let scale = -(inv_dt * inv_dt);
+        let forces = report.collider_forces.iter_mut().zip(self.collider_push);
+        for (force, push) in forces.take(colliders) {
+            *force += push * scale;
+        }
+    }
+}

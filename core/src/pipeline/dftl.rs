@@ -1,0 +1,501 @@
+//! DFTL's pipeline: Sánchez-Banderas, Barreiro, García-Fernández, Pérez 2015, Algorithm 1,
+//! local dynamics (lines 12–27), on one strand ([`step_strand`]) or on a structure-of-arrays
+//! block of `W` strands ([`step_block`]), which gives the per-strand path's bits.
+//!
+//! | line | Algorithm 1 | stage |
+//! |---|---|---|
+//! | 1–11 | global dynamics (SPH) | the std harness, an input of the step |
+//! | 12–15 | each particle after the root: external forces, predict `x*` | `dftl::predict` |
+//! | (12) | the root follows the head | `root_coupling` |
+//! | 18 | shape constraints | `dftl::shape` |
+//! | 19 | inextensibility constraint | `dftl::follow_leader` |
+//! | 20 | handle collisions | `dftl::collisions` |
+//! | 21 | update coordinate frames | `dftl::frame` |
+//! | 24–26 | velocity with the correction term; `x ← x*` | `dftl::velocity` |
+//!
+//! Lines 12–27 run fused, node by node, in one pass from the root ([`advance`] is lines
+//! 13–21 for one node); lines 24–26 run one node behind, as soon as the next node's
+//! correction is known, so a step is a single pass whose cost is fixed by the scene. The
+//! stages are counted in the algorithm's order: a node's prediction does not depend on the
+//! root coupling of nodes 0 and 1, so predicting first is the same computation. Before and
+//! after the pass, the quarantine every path shares: `snapshot` and `guard`.
+
+use crate::capacities::MAX_COLLIDERS;
+use crate::collide::Shape;
+use crate::context::StepContext;
+use crate::dftl::block::{read_lanes, BlockPositions, DftlBlock};
+use crate::dftl::measures::{ColliderPush, Measures, Tally};
+use crate::dftl::node::{Advanced, Chain, NodeInput, Setup};
+use crate::dftl::{collisions, follow_leader, frame, predict, shape, velocity};
+use crate::guard::guard;
+use crate::lane::{not_finite, Lane, Wide, WideMask, V3};
+use crate::math::{Math, Real, Vec3};
+use crate::report::{Stage, StepReport};
+use crate::root_coupling::root_coupling;
+use crate::snapshot::{snapshot, Positions};
+use crate::strand::{Strand, StrandState};
+
+/// Calls `pass::<…, SHAPE, INEXTENSIBLE, DRAG>(…)` with the scene's three effect switches
+/// (`setup.shape`, `.inextensibility`, `.drag`) as constants: each copy of a pass then
+/// computes no stage that is off and tests no switch per node. Both paths go through it.
+macro_rules! with_effect_switches {
+    ($setup:expr, $pass:ident::<$($generic:tt),*>($($argument:expr),* $(,)?)) => {
+        match ($setup.shape, $setup.inextensibility, $setup.drag) {
+            (false, false, false) => $pass::<$($generic),*, false, false, false>($($argument),*),
+            (false, false, true) => $pass::<$($generic),*, false, false, true>($($argument),*),
+            (false, true, false) => $pass::<$($generic),*, false, true, false>($($argument),*),
+            (false, true, true) => $pass::<$($generic),*, false, true, true>($($argument),*),
+            (true, false, false) => $pass::<$($generic),*, true, false, false>($($argument),*),
+            (true, false, true) => $pass::<$($generic),*, true, false, true>($($argument),*),
+            (true, true, false) => $pass::<$($generic),*, true, true, false>($($argument),*),
+            (true, true, true) => $pass::<$($generic),*, true, true, true>($($argument),*),
+        }
+    };
+}
+
+/// Steps one strand by `ctx.dt` (SB15 Algorithm 1, local dynamics), `setup` being
+/// [`Setup::new`] of `ctx` (built once for all strands). `index` is the strand's index in the
+/// whole scene; `accelerations` (if any) are the caller's per-node accelerations for this
+/// strand, indexed by node. Never panics: a strand that writes a non-finite value is rolled
+/// back.
+pub fn step_strand<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    setup: &Setup,
+    ctx: &StepContext,
+    index: u32,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    // Quarantine: the last good positions.
+    let last_good: Positions<N> = snapshot(strand, report);
+    // Lines 12–15, fused into the pass below: external forces and the prediction.
+    count_prediction(ctx, accelerations.is_some(), 1, report);
+    // The root follows the head: nodes 0 and 1.
+    let roots = root_coupling(strand, ctx, report);
+    // Lines 16–27 in one pass from the root: shape, follow-the-leader, collisions, frames, and
+    // the velocities one node behind.
+    count_constraints(setup, 1, report);
+    let pass = strand_pass::<M, N>(setup, ctx, strand, accelerations, report);
+    // Quarantine: every value written finite, or the last good positions back.
+    let good = roots + pass == 0.0;
+    guard(strand, &last_good, |_, _| good, index, report);
+}
+
+/// Counts lines 12–15, fused into the pass: the external forces where any act, and the
+/// prediction.
+fn count_prediction(ctx: &StepContext, accelerations: bool, strands: u32, report: &mut StepReport) {
+    if ctx.gates.external || accelerations {
+        report.ran_on(Stage::ExternalForces, strands);
+    }
+    report.ran_on(Stage::Integrate, strands);
+}
+
+/// Counts lines 16–27, the stages of the pass that run: shape, follow-the-leader, collisions,
+/// velocities.
+fn count_constraints(setup: &Setup, strands: u32, report: &mut StepReport) {
+    if setup.shape {
+        report.ran_on(Stage::Shape, strands);
+    }
+    if setup.inextensibility {
+        report.ran_on(Stage::Projection, strands);
+    }
+    if setup.collisions {
+        report.ran_on(Stage::Collisions, strands);
+    }
+    report.ran_on(Stage::Velocity, strands);
+}
+
+/// The pass over one strand's free nodes with the effect switches fixed, and its tally into
+/// the report. Returns [`not_finite`] summed over the velocities it wrote.
+fn strand_pass<M: Math, const N: usize>(
+    setup: &Setup,
+    ctx: &StepContext,
+    strand: &mut Strand<N>,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) -> Real {
+    if strand.rest.nodes.min(N) < 3 {
+        return 0.0;
+    }
+    let colliders = ctx.colliders();
+    let mut collider_push = [V3::zero(); MAX_COLLIDERS];
+    let (measures, poison) = with_effect_switches!(
+        setup,
+        nodes_of_strand::<M, N>(setup, strand, colliders, accelerations, &mut collider_push)
+    );
+    Tally::from_measures::<M>(&measures, &collider_push).report(
+        report,
+        colliders.len(),
+        setup.inv_dt,
+    );
+    poison
+}
+
+/// Nodes `2 …` of one strand with the effect switches fixed: lines 13–21 for node `i`, then
+/// lines 24–26 for node `i − 1`. Returns what it measured and the sum of [`not_finite`] over
+/// the velocities it wrote.
+#[inline(never)]
+fn nodes_of_strand<
+    M: Math,
+    const N: usize,
+    const SHAPE: bool,
+    const INEXTENSIBLE: bool,
+    const DRAG: bool,
+>(
+    setup: &Setup,
+    strand: &mut Strand<N>,
+    colliders: &[Shape],
+    accelerations: Option<&[Vec3]>,
+    collider_push: &mut ColliderPush<Real>,
+) -> (Measures<Real>, Real) {
+    let setup = setup.with_switches(SHAPE, INEXTENSIBLE, DRAG);
+    let n = strand.rest.nodes.min(N);
+    let rest = &strand.rest;
+    let state = &mut strand.state;
+    let (root_tangent, root_normal) = (rest.dftl.root_tangent, rest.dftl.root_normal);
+    let x1 = state.position[1];
+    let mut chain = Chain::start(&setup, root_tangent.into(), root_normal.into(), x1.into());
+    let mut measures = Measures::default();
+    let mut poison: Real = 0.0;
+    let mut previous_contact = false;
+    for i in 2..n {
+        let extra = accelerations.and_then(|a| a.get(i)).copied();
+        let node = NodeInput::of_strand(rest, state, i, extra);
+        // Lines 13–21: predict, shape, follow the leader, collisions, frame.
+        let (m, c) = (&mut measures, &mut *collider_push);
+        let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
+        // Lines 24–26 for node i − 1, now that node i's correction is known.
+        if i > 2 {
+            poison += finish_node(&setup, state, i - 1, chain.position, next.correction);
+        }
+        chain = next.chain;
+        previous_contact = next.contact;
+    }
+    // The last node: no correction (eq. 14 has no node n).
+    poison += finish_node(&setup, state, n - 1, chain.position, V3::zero());
+    (measures, poison)
+}
+
+/// Lines 24–26 for node `i` of one strand: its velocity with the next node's correction,
+/// `x ← x*`. Returns [`not_finite`] of the velocity.
+#[inline(always)]
+fn finish_node<const N: usize>(
+    setup: &Setup,
+    state: &mut StrandState<N>,
+    i: usize,
+    x_star: V3<Real>,
+    next_correction: V3<Real>,
+) -> Real {
+    let (x_new, v_new) = velocity::finish(setup, x_star, state.position[i].into(), next_correction);
+    state.position[i] = x_new.into();
+    state.velocity[i] = v_new.into();
+    not_finite(v_new)
+}
+
+/// SB15 Algorithm 1 lines 13–21 for node `i` of every lane (a lane where the node is not
+/// `active` computes but adds nothing): predict, shape, follow the leader, collisions, the
+/// frame, and the segment's strain for the report. One function for the per-strand path
+/// (`T = Real`) and the block path, so both run the same operations per strand.
+#[inline(always)]
+#[must_use]
+pub fn advance<M: Math, T: Lane>(
+    setup: &Setup,
+    colliders: &[Shape],
+    node: &NodeInput<T>,
+    chain: &Chain<T>,
+    previous_contact: T::Mask,
+    measures: &mut Measures<T>,
+    collider_push: &mut ColliderPush<T>,
+) -> Advanced<T> {
+    // Lines 13–14: external accelerations, prediction (eq. 1).
+    let a = predict::acceleration(
+        setup,
+        node.velocity,
+        node.inverse_mass,
+        node.extra,
+        node.has_extra,
+    );
+    let mut x = predict::predicted_position(setup, node.position, node.velocity, a);
+    // Line 18: shape, eqs. (8), (9) — the local target uses x* after the global step. Eq.
+    // (14) feeds back the local and the follow-the-leader corrections, not the global one
+    // (`dftl::velocity` says why).
+    let mut correction = V3::zero();
+    if setup.shape {
+        x = x + shape::global_correction(setup, node.rest_position, node.root_distance, x);
+        let (previous, tangent, normal) = (chain.position, chain.tangent, chain.normal);
+        let local = (node.local_rest, node.root_distance);
+        correction = shape::local_correction(setup, previous, tangent, normal, local.0, local.1, x);
+        x = x + correction;
+    }
+    // Line 19: follow the leader, eq. (10); its direction is the frame's next tangent.
+    let (mut tangent, mut tangent_known) = (chain.tangent, T::mask(false));
+    if setup.inextensibility {
+        let (projected, t) =
+            follow_leader::project::<M, T>(chain.position, x, node.segment_length, chain.tangent);
+        correction = correction + (projected - x);
+        (x, tangent, tangent_known) = (projected, t, T::mask(true));
+    }
+    // Line 20: collisions, each collider in turn (not part of the correction).
+    let mut contact = T::mask(false);
+    if setup.collisions {
+        let node_mass = (node.active, node.mass);
+        (x, contact) =
+            collisions::resolve::<M, T>(colliders, x, node_mass, measures, collider_push);
+    }
+    // The segment's strain, for the report.
+    let segment = measures.segment(
+        setup.collisions,
+        chain.position,
+        x,
+        node,
+        contact | previous_contact,
+    );
+    // Line 21: the frame, carried only when the shape constraints need it. The tangent from
+    // follow-the-leader holds unless a collider moved the node (or there was no projection).
+    let (tangent, normal) = if setup.shape {
+        frame::carry::<M, T>(chain, &segment, tangent, tangent_known & !contact)
+    } else {
+        (chain.tangent, chain.normal)
+    };
+    let chain = Chain {
+        position: x,
+        tangent,
+        normal,
+    };
+    Advanced {
+        chain,
+        correction,
+        contact,
+    }
+}
+
+/// Steps every block of `blocks` (strand `b·W + l` of the scene is lane `l` of block `b`,
+/// counted from `first_strand`). `accelerations`, if any, holds `N` entries per strand from
+/// the first strand of `blocks` (as `pipeline::step_strands`). The std harness splits the
+/// blocks over threads by a fixed partition and merges the reports in block order.
+pub fn step_blocks<M: Math, const W: usize, const N: usize>(
+    ctx: &StepContext,
+    blocks: &mut [DftlBlock<W, N>],
+    first_strand: u32,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    for (b, block) in blocks.iter_mut().enumerate() {
+        let block_accelerations = accelerations.and_then(|a| a.get(b * W * N..));
+        let first = first_strand.wrapping_add((b * W) as u32);
+        step_block::<M, W, N>(ctx, block, first, block_accelerations, report);
+    }
+}
+
+/// Steps one block by `ctx.dt`: the pipeline of [`step_strand`] on every lane at once, with the
+/// same stages, and the same bits on each strand.
+pub fn step_block<M: Math, const W: usize, const N: usize>(
+    ctx: &StepContext,
+    block: &mut DftlBlock<W, N>,
+    first_strand: u32,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    let setup = Setup::new(ctx);
+    let lanes = block.strands.min(W) as u32;
+    // Quarantine: every lane's last good positions.
+    let last_good: BlockPositions<W, N> = snapshot(block, report);
+    // Lines 12–15, fused into the pass below: external forces and the prediction.
+    count_prediction(ctx, accelerations.is_some(), lanes, report);
+    // The root follows the head: nodes 0 and 1 of every lane.
+    let roots = root_coupling(block, ctx, report);
+    // Lines 16–27 in one pass from the root, all lanes together.
+    count_constraints(&setup, lanes, report);
+    let pass = with_effect_switches!(
+        setup,
+        block_pass::<M, W, N>(ctx, &setup, block, accelerations, report)
+    );
+    // Quarantine: a lane that wrote a non-finite value gets its last good positions back.
+    let poison = roots + pass;
+    guard(
+        block,
+        &last_good,
+        |_, l| poison.0[l] == 0.0,
+        first_strand,
+        report,
+    );
+}
+
+/// What the node loop of a block carries from node to node.
+struct Carried<'a, const W: usize> {
+    chain: &'a mut Chain<Wide<W>>,
+    previous_contact: &'a mut WideMask<W>,
+    measures: &'a mut Measures<Wide<W>>,
+    collider_push: &'a mut ColliderPush<Wide<W>>,
+    poison: &'a mut Wide<W>,
+}
+
+/// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
+/// tally into the report. Returns [`not_finite`] summed over the velocities each lane wrote.
+#[inline(never)]
+fn block_pass<
+    M: Math,
+    const W: usize,
+    const N: usize,
+    const SHAPE: bool,
+    const INEXTENSIBLE: bool,
+    const DRAG: bool,
+>(
+    ctx: &StepContext,
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) -> Wide<W> {
+    let setup = setup.with_switches(SHAPE, INEXTENSIBLE, DRAG);
+    let max_nodes = block.max_nodes.min(N);
+    let mut poison = Wide::splat(0.0);
+    if max_nodes < 3 {
+        return poison;
+    }
+    let nodes = block.nodes;
+    let nodes_real = Wide(core::array::from_fn(|l| nodes[l] as Real));
+    // The chain at node 1: `R_head R̂_0`, all lanes at once.
+    let (tangent, normal) = (
+        read_lanes(&block.root_tangent),
+        read_lanes(&block.root_normal),
+    );
+    let mut chain = Chain::start(
+        &setup,
+        tangent,
+        normal,
+        read_lanes(&block.state[1].position),
+    );
+    let mut measures: Measures<Wide<W>> = Measures::default();
+    let mut collider_push: ColliderPush<Wide<W>> = [V3::zero(); MAX_COLLIDERS];
+    let mut previous_contact = Wide::<W>::mask(false);
+    // Nodes every lane has: there every lane is active and every selection below is a
+    // constant (the same bits as the masked form, without its blends).
+    let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
+    for k in 2..max_nodes {
+        let carried = Carried {
+            chain: &mut chain,
+            previous_contact: &mut previous_contact,
+            measures: &mut measures,
+            collider_push: &mut collider_push,
+            poison: &mut poison,
+        };
+        // Node 2 finishes nothing (node 1 is held); past the shortest lane the masks select.
+        let (b, a, n) = (&mut *block, accelerations, nodes_real);
+        match (k == 2, k < common) {
+            (true, true) => block_node::<M, W, N, true, false>(ctx, &setup, b, k, n, a, carried),
+            (true, false) => block_node::<M, W, N, false, false>(ctx, &setup, b, k, n, a, carried),
+            (false, true) => block_node::<M, W, N, true, true>(ctx, &setup, b, k, n, a, carried),
+            (false, false) => block_node::<M, W, N, false, true>(ctx, &setup, b, k, n, a, carried),
+        }
+    }
+    // The last node of the longest lanes: no correction.
+    let longest = WideMask(core::array::from_fn(|l| nodes[l] == max_nodes));
+    poison = poison
+        + finish_lanes(
+            &setup,
+            block,
+            max_nodes - 1,
+            longest,
+            chain.position,
+            V3::zero(),
+        );
+    tally_lanes::<M, W, N>(ctx, &setup, block, &measures, &collider_push, report);
+    poison
+}
+
+/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and, with `FINISH` (`k > 2`), lines
+/// 24–26 for node `k − 1`. With `ALL` every lane has node `k`: the masks are constants.
+#[inline(always)]
+fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: bool>(
+    ctx: &StepContext,
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    k: usize,
+    nodes_real: Wide<W>,
+    accelerations: Option<&[Vec3]>,
+    carried: Carried<'_, W>,
+) {
+    let node_index = Wide::splat(k as Real);
+    let (active, finishing) = if ALL {
+        (Wide::<W>::mask(true), Wide::<W>::mask(true))
+    } else {
+        // Node k − 1 exists in this lane and is free: it is finished now.
+        (
+            node_index.lt(nodes_real),
+            (node_index - Wide::splat(1.0)).lt(nodes_real),
+        )
+    };
+    let Some(node) = block.node_input(k, active, accelerations) else {
+        return;
+    };
+    // Lines 13–21, the per-strand path's function on every lane.
+    let next = advance::<M, Wide<W>>(
+        setup,
+        ctx.colliders(),
+        &node,
+        &*carried.chain,
+        *carried.previous_contact,
+        carried.measures,
+        carried.collider_push,
+    );
+    // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
+    if FINISH {
+        let next_correction = V3::select(active, next.correction, V3::zero());
+        let x_star = carried.chain.position;
+        let written = finish_lanes(setup, block, k - 1, finishing, x_star, next_correction);
+        *carried.poison = *carried.poison + written;
+    }
+    *carried.chain = Chain::select(active, &next.chain, carried.chain);
+    *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
+}
+
+/// Lines 24–26 for node `k` of the lanes where `finishing`: the velocity with the next node's
+/// correction, `x ← x*`; the other lanes keep theirs. Returns [`not_finite`] of the
+/// velocities now stored.
+#[inline(always)]
+fn finish_lanes<const W: usize, const N: usize>(
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    k: usize,
+    finishing: WideMask<W>,
+    x_star: V3<Wide<W>>,
+    next_correction: V3<Wide<W>>,
+) -> Wide<W> {
+    let Some(old_position) = block.state.get(k).map(|s| read_lanes(&s.position)) else {
+        return Wide::splat(0.0);
+    };
+    let (x_new, v_new) = velocity::finish(setup, x_star, old_position, next_correction);
+    not_finite(block.store_node_where(k, finishing, x_new, v_new))
+}
+
+/// Each lane's tally into the report, in lane order.
+fn tally_lanes<M: Math, const W: usize, const N: usize>(
+    ctx: &StepContext,
+    setup: &Setup,
+    block: &DftlBlock<W, N>,
+    measures: &Measures<Wide<W>>,
+    collider_push: &ColliderPush<Wide<W>>,
+    report: &mut StepReport,
+) {
+    let (stretch, contact_stretch) = measures.stretches::<M>();
+    for l in 0..block.strands.min(W) {
+        // The pushes are only read with colliders in the scene: no lane gathering without.
+        let collider_push = if setup.collisions {
+            collider_push.map(|v| Vec3::new(v.x.0[l], v.y.0[l], v.z.0[l]))
+        } else {
+            [Vec3::ZERO; MAX_COLLIDERS]
+        };
+        let tally = Tally {
+            stretch: stretch.0[l],
+            contact_stretch: contact_stretch.0[l],
+            penetration: measures.penetration.0[l],
+            contacts: measures.contacts.0[l] as u32,
+            collider_push,
+        };
+        tally.report(report, ctx.colliders().len(), setup.inv_dt);
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,136 @@
+//! The step pipelines: one function per solver that reads top to bottom like its paper's
+//! Algorithm 1, one stage per line, each gated once by the step's gates
+//! (`context::Gates`): [`rod::step_strand`] (Kmoch 2009) and [`dftl::step_strand`] with
+//! [`dftl::step_block`] (Sánchez-Banderas 2015). Every path goes through the same snapshot,
+//! root-coupling and guard stages.
+//!
+//! A step, as every caller runs it (the fixed-capacity `World::step` for firmware, the std
+//! harness's `Sim::step` over threads):
+//!
+//! 1. [`begin`]: the caller's inputs checked — grab targets and releases, the head pose (a
+//!    non-finite one is flagged `BAD_INPUT` and the last pose kept) — the step's context built
+//!    with DFTL's coefficients from set-up and the wind at the step's end time, and the grabs
+//!    no strand can reach let go;
+//! 2. the caller's per-node accelerations (the harness's SPH, SB15 Algorithm 1 lines 1–11),
+//!    an input of the step;
+//! 3. [`step_strands`] on the strands, in blocks of the caller's choosing (or
+//!    [`dftl::step_blocks`] on DFTL's structure-of-arrays blocks);
+//! 4. [`finish`]: the grabs that slipped during the step let go.
+
+pub mod dftl;
+pub mod rod;
+
+use crate::collide::Collider;
+use crate::context::StepContext;
+use crate::dftl::node::Setup;
+use crate::effects::Solver;
+use crate::grab::{apply_slips, retarget, slip_unreachable, Grab, GrabStatus};
+use crate::head::Pose;
+use crate::math::{Math, Real, Vec3};
+use crate::params::{DftlCoefficients, Params};
+use crate::report::{Flags, StepReport};
+use crate::strand::Strand;
+
+/// Steps a block of strands by one `ctx.dt` through its solver's pipeline. `first_strand` is
+/// the index of `strands[0]` in the whole scene (for grabs and the report); `accelerations`,
+/// if any, holds `N` entries per strand of this block. Never panics; a strand that turns
+/// non-finite is rolled back.
+pub fn step_strands<M: Math, const N: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    first_strand: u32,
+    grabs: &[Grab],
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
+    match ctx.params.solver {
+        Solver::Rod => {
+            for (k, strand) in strands.iter_mut().enumerate() {
+                let index = first_strand + k as u32;
+                rod::step_strand::<M, N>(strand, ctx, grabs, index, of_strand(k), report);
+            }
+        }
+        Solver::Dftl => {
+            // What a DFTL step derives from the context (the head's rotation matrix among it)
+            // is the same for every strand: once per block.
+            let setup = Setup::new(ctx);
+            for (k, strand) in strands.iter_mut().enumerate() {
+                let index = first_strand + k as u32;
+                dftl::step_strand::<M, N>(strand, &setup, ctx, index, of_strand(k), report);
+            }
+        }
+    }
+}
+
+/// What a step reads and changes of its caller's world.
+#[derive(Debug)]
+pub struct Stepping<'a, const N: usize> {
+    /// The parameters.
+    pub params: &'a Params,
+    /// DFTL's coefficients at `params.dt`, computed once at set-up.
+    pub dftl: DftlCoefficients,
+    /// The colliders.
+    pub colliders: &'a [Collider],
+    /// The grabs, which the step's inputs move and release.
+    pub grabs: &'a mut [Grab],
+    /// The strands.
+    pub strands: &'a [Strand<N>],
+    /// The head's pose at the start of the step.
+    pub head: Pose,
+    /// Steps taken so far.
+    pub steps: u64,
+}
+
+/// What the caller hands in for one step, before any check.
+#[derive(Clone, Copy, Debug)]
+pub struct Inputs<'a> {
+    /// The head's pose at the end of the step.
+    pub head: Pose,
+    /// Each grab's new target (a grab past the end keeps its target).
+    pub grab_targets: &'a [Vec3],
+    /// Each grab: whether the caller lets go of it now (a grab past the end is kept).
+    pub released: &'a [bool],
+}
+
+/// Begins a step of `world` with `inputs`: releases and moves the grabs (a non-finite target
+/// is ignored and flagged [`Flags::BAD_INPUT`]), takes the head pose (a non-finite one is
+/// ignored, flagged, and the last pose kept), builds the step's context at the step's end
+/// time `(steps + 1) · dt`, and lets go the grabs no strand can reach
+/// (`grab::slip_unreachable`). The context's `head` is the pose the step ends at.
+pub fn begin<const N: usize>(
+    world: Stepping<'_, N>,
+    inputs: &Inputs<'_>,
+    report: &mut StepReport,
+) -> StepContext {
+    for (g, grab) in world.grabs.iter_mut().enumerate() {
+        if inputs.released.get(g).copied().unwrap_or(false) {
+            grab.status = GrabStatus::Released;
+        }
+        if let Some(&target) = inputs.grab_targets.get(g) {
+            if !retarget(grab, target) {
+                report.flags.insert(Flags::BAD_INPUT);
+            }
+        }
+    }
+    let head = if inputs.head.is_finite() {
+        inputs.head
+    } else {
+        report.flags.insert(Flags::BAD_INPUT);
+        world.head
+    };
+    let time = (world.steps + 1) as Real * world.params.dt;
+    let ctx =
+        StepContext::with_coefficients(world.params, world.dftl, world.head, head, world.colliders)
+            .at_time(time);
+    slip_unreachable(&ctx, world.grabs, world.strands, 0, report);
+    ctx
+}
+
+/// Ends a step: every grab that slipped during it (`report.grabs_slipped`) lets go.
+pub fn finish(grabs: &mut [Grab], report: &StepReport) {
+    apply_slips(grabs, report);
+}
+
+#[cfg(test)]
+mod tests;

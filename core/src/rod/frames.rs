@@ -1,0 +1,231 @@
+//! The frames of a rod strand's current configuration (Kmoch 2009 Sec. 5, BWR08 Sec. 4): its
+//! segments, tangents and curvature binormals, the Bishop frame in space carried from the root
+//! frame `u^0`, the binormals' components in it, the material angles' cosines and sines, and
+//! the binormal directions the hair-optimised twist follows (Kmoch Sec. 6.2). Computed once per
+//! force evaluation and shared by the energies, the forces, the twist and the rest data.
+//!
+//! Generic over a [`Precision`] so that the finite-difference tests run in `f64`.
+
+use crate::frames::{curvature_binormal, parallel_transport};
+use crate::math::Math;
+use crate::precision::{Precision, Scalar, Vector};
+use crate::strand::Strand;
+
+/// The representative of the direction `(cos φ, sin φ)` (an unoriented line, defined mod π)
+/// closest to `reference`: `θ = φ + kπ`, with `φ = atan2(sin φ, cos φ)` given. Returns `θ`,
+/// `(cos θ, sin θ)`, and whether `k` is odd (the direction flipped).
+#[inline(always)]
+#[must_use]
+pub fn representative_near<R: Scalar>(
+    phi: R,
+    direction: [R; 2],
+    reference: R,
+) -> (R, [R; 2], bool) {
+    let [c, s] = direction;
+    // On the twist sweep's sequential chain (`reference` is the neighbour's new angle): a
+    // multiplication by 1/π rather than a division, and the parity from the integer.
+    let (k, odd) = ((reference - phi) * R::FRAC_1_PI + R::of(0.5)).floor_and_parity();
+    let cos_sin = if odd { [-c, -s] } else { [c, s] };
+    (phi + k * R::PI, cos_sin, odd)
+}
+
+/// The frames of a strand's current configuration: segments, tangents, curvature binormals,
+/// the Bishop frame in space from the root frame `u^0`, and the binormals' Bishop components.
+/// Computed once per force evaluation and shared by the energy, forces and twist.
+#[derive(Clone, Debug)]
+pub struct RodFrames<P: Precision, const N: usize> {
+    /// Nodes in use.
+    pub nodes: usize,
+    /// `e^j = x_{j+1} − x_j`.
+    pub edge: [P::V; N],
+    /// `|e^j|`.
+    pub length: [P::R; N],
+    /// `1 / |e^j|`.
+    pub inverse_length: [P::R; N],
+    /// `t^j = e^j / |e^j|`.
+    pub tangent: [P::V; N],
+    /// `(κb)_i`, `i = 1 … n`.
+    pub curvature_binormal: [P::V; N],
+    /// `d_i = |ê^{i−1}||ê^i| + e^{i−1}·e^i`, the binormal's denominator.
+    pub denominator: [P::R; N],
+    /// Bishop `u^j`.
+    pub bishop_u: [P::V; N],
+    /// Bishop `v^j = t^j × u^j`.
+    pub bishop_v: [P::V; N],
+    /// `[p^{i−1}_i, p^i_i]` with `p^j_i = ((κb)_i·v^j, −(κb)_i·u^j)`: the material curvature at
+    /// `θ^j = 0`.
+    pub bishop_curvature: [[[P::R; 2]; 2]; N],
+}
+
+impl<P: Precision, const N: usize> RodFrames<P, N> {
+    /// The frames of the polyline `positions` (≤ `N` nodes) with root Bishop vector
+    /// `root_frame` and rest segment lengths `rest_length`.
+    #[must_use]
+    pub fn compute(positions: &[P::V], root_frame: P::V, rest_length: &[P::R]) -> Self {
+        let mut f = Self::empty();
+        f.recompute(positions, root_frame, rest_length);
+        f
+    }
+
+    /// Frames of no polyline: every entry at the value [`Self::compute`] leaves where it
+    /// writes nothing (no binormal at the root or the tip, denominator 1).
+    #[must_use]
+    pub fn empty() -> Self {
+        let zero = <P::V as Vector<P::R>>::ZERO;
+        RodFrames {
+            nodes: 0,
+            edge: [zero; N],
+            length: [P::R::ZERO; N],
+            inverse_length: [P::R::ZERO; N],
+            tangent: [zero; N],
+            curvature_binormal: [zero; N],
+            denominator: [P::R::ONE; N],
+            bishop_u: [zero; N],
+            bishop_v: [zero; N],
+            bishop_curvature: [[[P::R::ZERO; 2]; 2]; N],
+        }
+    }
+
+    /// [`Self::compute`] in place, for a buffer that is [`Self::empty`] or last held a
+    /// polyline of as many nodes: it writes every entry `compute` writes, so the result is
+    /// the same, bit for bit, without building (zeroing, then moving) a new one. The rod step
+    /// recomputes its frames five times a step (four substeps and the twist): on the
+    /// Cortex-M4F the zeroing and moving cost 6 % of the step.
+    pub fn recompute(&mut self, positions: &[P::V], root_frame: P::V, rest_length: &[P::R]) {
+        let f = self;
+        f.nodes = positions.len().min(N);
+        let segments = f.nodes.saturating_sub(1).min(rest_length.len());
+        // One pass root → tip: segment, tangent, Bishop frame by parallel transport (Kmoch
+        // Sec. 5), then the binormal at the node behind it and its Bishop components.
+        for j in 0..segments {
+            let e = positions[j + 1] - positions[j];
+            let length = P::sqrt(e.dot(e));
+            let inverse_length = P::R::ONE / length;
+            let t = e * inverse_length;
+            let u = if j == 0 {
+                root_frame
+            } else {
+                parallel_transport::<P>(f.tangent[j - 1], t, f.bishop_u[j - 1])
+            };
+            f.edge[j] = e;
+            f.length[j] = length;
+            f.inverse_length[j] = inverse_length;
+            f.tangent[j] = t;
+            f.bishop_u[j] = u;
+            f.bishop_v[j] = t.cross(u);
+            if j > 0 {
+                let i = j;
+                let (kb, d) =
+                    curvature_binormal::<P>(f.edge[i - 1], e, rest_length[i - 1], rest_length[i]);
+                f.curvature_binormal[i] = kb;
+                f.denominator[i] = d;
+                f.bishop_curvature[i] = [
+                    [kb.dot(f.bishop_v[i - 1]), -kb.dot(f.bishop_u[i - 1])],
+                    [kb.dot(f.bishop_v[i]), -kb.dot(f.bishop_u[i])],
+                ];
+            }
+        }
+    }
+
+    /// Number of interior nodes `n` (nodes with a curvature binormal).
+    #[must_use]
+    pub fn interior(&self) -> usize {
+        self.nodes.saturating_sub(2)
+    }
+}
+
+impl<M: Math, const N: usize> RodFrames<M, N> {
+    /// Kmoch Sec. 5, the Bishop frame in space: these frames recomputed in place for the
+    /// strand's current centreline (from its root frame `u^0` and rest lengths).
+    pub fn refresh(&mut self, strand: &Strand<N>) {
+        let n = strand.rest.nodes.min(N);
+        self.recompute(
+            &strand.state.position[..n],
+            strand.state.root_frame,
+            &strand.rest.rod.rest_length,
+        );
+    }
+}
+
+/// `(cos θ^j, sin θ^j)` per segment: the only trigonometry of a force evaluation, one call per
+/// segment (never per holonomy term or per Newton row).
+#[must_use]
+pub fn material_angles<P: Precision, const N: usize>(theta: &[P::R]) -> [[P::R; 2]; N] {
+    let mut cos_sin = [[P::R::ONE, P::R::ZERO]; N];
+    for (slot, t) in cos_sin.iter_mut().zip(theta) {
+        let (s, c) = P::sin_cos(*t);
+        *slot = [c, s];
+    }
+    cos_sin
+}
+
+/// `ω = R(−θ) p`: the Bishop components `p` of a curvature binormal seen in the material frame
+/// rotated by `θ` (given as `(cos θ, sin θ)`). `∂ω/∂θ = (ω₂, −ω₁) = −Jω`.
+#[inline(always)]
+#[must_use]
+pub fn material_curvature<R: Scalar>(p: [R; 2], cos_sin: [R; 2]) -> [R; 2] {
+    let [c, s] = cos_sin;
+    [c * p[0] + s * p[1], c * p[1] - s * p[0]]
+}
+
+/// `ε²` in the binormal weights `|κb|² / (|κb|² + ε²)`: binormals much shorter than
+/// `ε = 1e-4` (a turning angle of 0.1 mrad) fade out of the average instead of dropping out at a
+/// threshold, so `θ` does not jump when a node straightens.
+pub const BINORMAL_FADE: f32 = 1.0e-8;
+/// Below this weight neither binormal says anything: the segment continues its neighbour.
+pub const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
+
+/// The direction `(cos φ, sin φ)`, defined mod π, that segment `j`'s material vector `m1`
+/// takes in the hair-optimised twist: the mean of the directions of the binormals at nodes `j`
+/// and `j + 1` in the Bishop frame of segment `j` (Kmoch Sec. 6.2), averaged as lines:
+/// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
+/// doubled angle is a complex square, the half angle a square root.
+///
+/// Two divisions: the weights `1/r_k` share one (`Σ z_k/r_k` is kept as a fraction), and the
+/// half angle of `z = X + iY` is `(|z| + X, Y)` (or `(Y, |z| − X)`, the same line, when
+/// `X < 0`), normalised once.
+#[inline(always)]
+#[must_use]
+pub fn binormal_direction<P: Precision, const N: usize>(
+    frames: &RodFrames<P, N>,
+    j: usize,
+) -> Option<[P::R; 2]> {
+    let n = frames.interior();
+    let fade = P::R::of(BINORMAL_FADE);
+    // Σ_k z_k / r_k with z_k = (a² − b², 2ab) and r_k = a² + b² + ε², as `sum / scale`.
+    let mut sum = [P::R::ZERO; 2];
+    let mut scale = P::R::ONE;
+    // (κb·u^j, κb·v^j) = (−p₁, p₀) for node j (frame j = its "next") and node j + 1 ("prev").
+    let mut add = |p: [P::R; 2]| {
+        let (a, b) = (-p[1], p[0]);
+        let r = a * a + b * b + fade;
+        sum[0] = sum[0] * r + (a * a - b * b) * scale;
+        sum[1] = sum[1] * r + P::R::of(2.0) * a * b * scale;
+        scale *= r;
+    };
+    if j >= 1 && j <= n {
+        add(frames.bishop_curvature[j][1]);
+    }
+    if j < n {
+        add(frames.bishop_curvature[j + 1][0]);
+    }
+    let inverse_scale = P::R::ONE / scale;
+    let (x, y) = (sum[0] * inverse_scale, sum[1] * inverse_scale);
+    let weight2 = x * x + y * y;
+    let min = P::R::of(BINORMAL_MIN_WEIGHT);
+    if weight2 <= min * min || !weight2.is_finite() {
+        return None;
+    }
+    let weight = P::sqrt(weight2);
+    let half_angle = if x >= P::R::ZERO {
+        [weight + x, y]
+    } else {
+        [y, weight - x]
+    };
+    let inverse_length =
+        P::R::ONE / P::sqrt(half_angle[0] * half_angle[0] + half_angle[1] * half_angle[1]);
+    Some([
+        half_angle[0] * inverse_length,
+        half_angle[1] * inverse_length,
+    ])
+}
