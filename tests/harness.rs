@@ -53,6 +53,7 @@ fn run_firmware_json_gives_the_firmwares_hash() {
         "caps_hit",
         "rolled_back",
         "collider_forces",
+        "groom",
     ] {
         assert!(json.get(key).is_some(), "{key} missing from {text}");
     }
@@ -135,6 +136,25 @@ fn one_and_two_threads_give_the_same_bits() {
         .unwrap()
         .state_hash
     );
+}
+
+#[test]
+fn the_groom_measure_covers_every_interior_node() {
+    for scene in ["firmware", "firmware-dftl"] {
+        let summary = hairsim::run::run_builtin(scene, &RunOptions::default()).unwrap();
+        let groom = summary.groom;
+        assert_eq!(groom.nodes, summary.nodes - 2 * summary.strands, "{scene}");
+        assert!((0.0..=1.0).contains(&groom.kinked), "{scene}: {groom:?}");
+        for angle in [groom.mean_turning, groom.rest_mean_turning] {
+            assert!(
+                (0.0..=core::f32::consts::PI).contains(&angle),
+                "{scene}: {groom:?}"
+            );
+        }
+        // The firmware scenes' strands are curved at rest.
+        assert!(groom.rest_mean_turning > 0.0, "{scene}: {groom:?}");
+        assert!(summary.to_text().contains("groom       mean turning"));
+    }
 }
 
 #[test]

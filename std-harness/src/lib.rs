@@ -14,6 +14,7 @@ pub use hairsim_files::{builtin, hairfile, hairscene, scene};
 
 pub mod cmd;
 pub mod export;
+pub mod groom;
 pub mod output;
 pub mod picture;
 pub mod record;

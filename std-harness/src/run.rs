@@ -494,6 +494,7 @@ fn summary<const N: usize, M: Math>(
         max_stretch: totals.max_stretch,
         max_penetration: totals.max_penetration,
         finite: sim.is_finite(),
+        groom: crate::groom::measure(&sim.strands),
         ms_per_step: median_ms(&mut outcome.times),
         iterations: totals.iterations,
         caps_hit: totals.caps_hit,

@@ -2,6 +2,8 @@
 
 use serde::Serialize;
 
+use crate::groom::Groom;
+
 /// What `hairsim run` reports.
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -37,6 +39,9 @@ pub struct Summary {
     pub max_penetration: f32,
     /// Whether the final state is finite everywhere.
     pub finite: bool,
+    /// The simulated strands' groom at the end against their rest groom: mean turning angle
+    /// and the share of kinked nodes ([`crate::groom`]).
+    pub groom: Groom,
     /// Median wall time of one step, ms.
     pub ms_per_step: f64,
     /// Projection iterations summed over the run.
@@ -127,6 +132,13 @@ impl Summary {
             self.caps_hit,
             self.rolled_back
         );
+        text.push_str(&format!(
+            "\ngroom       mean turning {:.3} rad (rest {:.3}), kinked {:.2} % of {} nodes",
+            self.groom.mean_turning,
+            self.groom.rest_mean_turning,
+            100.0 * self.groom.kinked,
+            self.groom.nodes
+        ));
         if let (Some(forces), Some(status)) = (&self.grab_forces, &self.grab_status) {
             text.push_str(&format!(
                 "\ngrabs       {} ({})",

@@ -7,6 +7,7 @@ use hairsim_core::math::FastMath;
 use hairsim_core::{Libm, Math, Vec3};
 
 use super::{arc_lengths, point_at, Backend, Config, Row};
+use crate::groom::{self, Groom};
 use crate::run::capacity_for;
 use crate::scene::Prepared;
 use crate::sim::{scene_inputs, Sim};
@@ -35,6 +36,8 @@ pub struct Trace {
     pub rolled_back: u64,
     /// Whether the state stayed finite.
     pub finite: bool,
+    /// The groom at the end against the rest groom ([`crate::groom`]).
+    pub groom: Groom,
 }
 
 /// Runs `prepared` for `duration` simulated seconds on one thread with `backend`, timing
@@ -106,6 +109,7 @@ fn simulate_n<const N: usize, M: Math>(prepared: &Prepared, duration: f64) -> Re
         steps,
         rolled_back,
         finite: sim.is_finite(),
+        groom: groom::measure(&sim.strands),
     })
 }
 
@@ -175,6 +179,7 @@ pub fn compare(config: Config, trace: &Trace, reference: &Trace) -> Row {
         max_stretch: trace.max_stretch,
         energy_error,
         rolled_back: trace.rolled_back,
+        groom: trace.groom,
         finite,
         stable: finite && trace.rolled_back == 0 && trace.max_stretch <= super::STABLE_STRETCH,
         pareto: false,

@@ -477,6 +477,9 @@ pub struct Row {
     pub energy_error: f64,
     /// Strands rolled back over the run.
     pub rolled_back: u64,
+    /// The groom at the end: mean turning angle and kinked nodes against the rest groom
+    /// (what DFTL's configurations keep of the hair's shape, beside their cost).
+    pub groom: crate::groom::Groom,
     /// Whether every value stayed finite.
     pub finite: bool,
     /// Whether the run stayed stable: finite, no roll-back, no segment stretched by more

@@ -33,12 +33,12 @@ fn error_kind(row: &Row) -> &'static str {
 #[must_use]
 pub fn to_csv(study: &Study) -> String {
     let mut s = String::from(
-        "scene,knob,value,config,us_per_step,us_per_sim_ms,rms_distance_m,error_kind,max_stretch,energy_error,rolled_back,finite,stable,pareto\n",
+        "scene,knob,value,config,us_per_step,us_per_sim_ms,rms_distance_m,error_kind,max_stretch,energy_error,rolled_back,mean_turning_rad,rest_mean_turning_rad,kinked_share,finite,stable,pareto\n",
     );
     for r in &study.rows {
         let _ = writeln!(
             s,
-            "{},{},{},{},{:.3},{:.3},{:.6e},{},{:.3e},{:.3e},{},{},{},{}",
+            "{},{},{},{},{:.3},{:.3},{:.6e},{},{:.3e},{:.3e},{},{:.4},{:.4},{:.4},{},{},{}",
             study.scene,
             r.config.knob.name(),
             r.config.value(),
@@ -50,6 +50,9 @@ pub fn to_csv(study: &Study) -> String {
             r.max_stretch,
             r.energy_error,
             r.rolled_back,
+            r.groom.mean_turning,
+            r.groom.rest_mean_turning,
+            r.groom.kinked,
             r.finite,
             r.stable,
             r.pareto
@@ -82,19 +85,21 @@ pub fn markdown(study: &Study) -> String {
          + gravitational energy from the reference's at ten sampled times, as a fraction of \
          Σ m|g|L. The nodes knob changes the discretisation: its distance is measured at the \
          reference's nodes by arc length, and includes the difference between discretisations. \
+         Groom: the mean turning angle at the interior nodes at the end (the rest groom's in \
+         brackets) and the share of nodes kinked, turning more than their rest angle + 0.3 rad. \
          A run is marked diverged when it rolled a strand back, went non-finite or stretched a \
          segment by more than 10 %; diverged runs are left out of the plot, the front and the \
          budget.\n",
         study.reference_max_stretch
     );
     s.push_str(
-        "| knob | value | µs/step | µs/sim ms | RMS distance (m) | error | max stretch | energy error | rolled back | front | configuration |\n",
+        "| knob | value | µs/step | µs/sim ms | RMS distance (m) | error | max stretch | energy error | groom (rad) | kinked | rolled back | front | configuration |\n",
     );
-    s.push_str("|---|---|---:|---:|---:|---|---:|---:|---:|:-:|---|\n");
+    s.push_str("|---|---|---:|---:|---:|---|---:|---:|---:|---:|---:|:-:|---|\n");
     for r in &study.rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {:.1} | {:.1} | {} | {} | {:.1e} | {:.1e} | {} | {} | `{}` |",
+            "| {} | {} | {:.1} | {:.1} | {} | {} | {:.1e} | {:.1e} | {:.3} ({:.3}) | {:.1} % | {} | {} | `{}` |",
             r.config.knob.name(),
             r.config.value(),
             r.us_per_step,
@@ -107,6 +112,9 @@ pub fn markdown(study: &Study) -> String {
             error_kind(r),
             r.max_stretch,
             r.energy_error,
+            r.groom.mean_turning,
+            r.groom.rest_mean_turning,
+            100.0 * r.groom.kinked,
             r.rolled_back,
             if r.pareto { "*" } else { "" },
             r.config.describe()
