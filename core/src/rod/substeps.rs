@@ -214,13 +214,18 @@ pub fn substeps_for_shape<const N: usize>(
     bending: bool,
     smallest_denominator: Real,
 ) -> u32 {
-    // A non-positive or NaN denominator (a fold) takes the cap.
-    let stiffening = if smallest_denominator > 0.0 {
+    substeps_at_stiffness(rest, dt, bending, stiffening(smallest_denominator))
+}
+
+/// How much stiffer than straight the shape with smallest binormal denominator `g` bends:
+/// `2/min(g, 2)`; a non-positive or NaN denominator (a fold) is infinitely stiff, so its count
+/// takes the cap.
+fn stiffening(smallest_denominator: Real) -> Real {
+    if smallest_denominator > 0.0 {
         2.0 / smallest_denominator.min(2.0)
     } else {
         Real::INFINITY
-    };
-    substeps_at_stiffness(rest, dt, bending, stiffening)
+    }
 }
 
 /// How much a fold may tighten within one step in converge mode, as a factor on the
@@ -241,12 +246,12 @@ pub fn substeps_within_step<const N: usize>(
     dt: Real,
     smallest_denominator: Real,
 ) -> u32 {
-    let stiffening = if smallest_denominator > 0.0 {
-        2.0 / smallest_denominator.min(2.0)
-    } else {
-        Real::INFINITY
-    };
-    substeps_at_stiffness(rest, dt, true, stiffening * STEP_ALLOWANCE)
+    substeps_at_stiffness(
+        rest,
+        dt,
+        true,
+        stiffening(smallest_denominator) * STEP_ALLOWANCE,
+    )
 }
 
 /// `⌈dt · stiffening / (SAFETY · dt_max)⌉` clamped to `1 ..= MAX_SUBSTEPS`; `stiffening ≥ 1`
