@@ -4,8 +4,9 @@
 //! One stage for every path: the rod's strands, DFTL's strands and DFTL's structure-of-arrays
 //! blocks all keep their last good state through [`snapshot`], each keeping what its solver
 //! writes ([`LastGood`]): the rod writes the whole state; DFTL writes positions and velocities
-//! only, and a roll-back zeroes the velocities, so the positions are all it keeps (less than
-//! half the state's bytes).
+//! only, and a roll-back zeroes the velocities, so a DFTL strand keeps its positions (less than
+//! half the state's bytes). A block keeps its state array whole, which is one contiguous copy
+//! (`dftl::block::BlockState` says why).
 
 use crate::math::Vec3;
 use crate::report::{Stage, StepReport};

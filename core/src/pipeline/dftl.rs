@@ -23,7 +23,7 @@
 use crate::capacities::MAX_COLLIDERS;
 use crate::collide::Shape;
 use crate::context::StepContext;
-use crate::dftl::block::{read_lanes, BlockPositions, DftlBlock};
+use crate::dftl::block::{read_lanes, BlockState, DftlBlock};
 use crate::dftl::measures::{ColliderPush, Measures, Tally};
 use crate::dftl::node::{Advanced, Chain, NodeInput, Setup};
 use crate::dftl::{collisions, follow_leader, frame, predict, shape, velocity};
@@ -299,7 +299,7 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
     let setup = Setup::new(ctx);
     let lanes = block.strands.min(W) as u32;
     // Quarantine: every lane's last good positions.
-    let last_good: BlockPositions<W, N> = snapshot(block, report);
+    let last_good: BlockState<W, N> = snapshot(block, report);
     // Lines 12–15, fused into the pass below: external forces and the prediction.
     count_prediction(ctx, accelerations.is_some(), lanes, report);
     // The root follows the head: nodes 0 and 1 of every lane.
@@ -380,13 +380,13 @@ fn block_pass<
             collider_push: &mut collider_push,
             poison: &mut poison,
         };
-        // Node 2 finishes nothing (node 1 is held); past the shortest lane the masks select.
+        // Node 2 finishes nothing (node 1 is held) and past the shortest lane the masks
+        // select: both take the masked copy, so the pass holds two copies of a node, not four.
         let (b, a, n) = (&mut *block, accelerations, nodes_real);
-        match (k == 2, k < common) {
-            (true, true) => block_node::<M, W, N, true, false>(ctx, &setup, b, k, n, a, carried),
-            (true, false) => block_node::<M, W, N, false, false>(ctx, &setup, b, k, n, a, carried),
-            (false, true) => block_node::<M, W, N, true, true>(ctx, &setup, b, k, n, a, carried),
-            (false, false) => block_node::<M, W, N, false, true>(ctx, &setup, b, k, n, a, carried),
+        if k > 2 && k < common {
+            block_node::<M, W, N, true>(ctx, &setup, b, k, n, a, carried);
+        } else {
+            block_node::<M, W, N, false>(ctx, &setup, b, k, n, a, carried);
         }
     }
     // The last node of the longest lanes: no correction.
@@ -404,10 +404,10 @@ fn block_pass<
     poison
 }
 
-/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and, with `FINISH` (`k > 2`), lines
-/// 24–26 for node `k − 1`. With `ALL` every lane has node `k`: the masks are constants.
+/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`
+/// where it is free (`k > 2`). With `ALL` every lane has both nodes: the masks are constants.
 #[inline(always)]
-fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool, const FINISH: bool>(
+fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     ctx: &StepContext,
     setup: &Setup,
     block: &mut DftlBlock<W, N>,
@@ -420,10 +420,13 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool, const FI
     let (active, finishing) = if ALL {
         (Wide::<W>::mask(true), Wide::<W>::mask(true))
     } else {
-        // Node k − 1 exists in this lane and is free: it is finished now.
+        // Node k − 1 exists in this lane and is free (node 1 is held): it is finished now. A
+        // lane not finishing keeps its node as it is, so node 2 gives the bits of a pass that
+        // finishes nothing there.
+        let free = Wide::<W>::mask(k > 2);
         (
             node_index.lt(nodes_real),
-            (node_index - Wide::splat(1.0)).lt(nodes_real),
+            (node_index - Wide::splat(1.0)).lt(nodes_real) & free,
         )
     };
     let Some(node) = block.node_input(k, active, accelerations) else {
@@ -440,12 +443,10 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool, const FI
         carried.collider_push,
     );
     // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
-    if FINISH {
-        let next_correction = V3::select(active, next.correction, V3::zero());
-        let x_star = carried.chain.position;
-        let written = finish_lanes(setup, block, k - 1, finishing, x_star, next_correction);
-        *carried.poison = *carried.poison + written;
-    }
+    let next_correction = V3::select(active, next.correction, V3::zero());
+    let x_star = carried.chain.position;
+    let written = finish_lanes(setup, block, k - 1, finishing, x_star, next_correction);
+    *carried.poison = *carried.poison + written;
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }
