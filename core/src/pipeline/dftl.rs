@@ -298,7 +298,7 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
 ) {
     let setup = Setup::new(ctx);
     let lanes = block.strands.min(W) as u32;
-    // Quarantine: every lane's last good positions.
+    // Quarantine: every lane's last good state.
     let last_good: BlockState<W, N> = snapshot(block, report);
     // Lines 12–15, fused into the pass below: external forces and the prediction.
     count_prediction(ctx, accelerations.is_some(), lanes, report);
