@@ -28,7 +28,7 @@ use crate::dftl::measures::{ColliderPush, Measures, Tally};
 use crate::dftl::node::{Advanced, Chain, NodeInput, Setup};
 use crate::dftl::{collisions, follow_leader, frame, predict, shape, velocity};
 use crate::guard::guard;
-use crate::lane::{not_finite, Lane, Wide, WideMask, V3};
+use crate::lane::{component_sum, not_finite_sum, Lane, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::report::{Stage, StepReport};
 use crate::root_coupling::root_coupling;
@@ -106,7 +106,7 @@ fn count_constraints(setup: &Setup, strands: u32, report: &mut StepReport) {
 }
 
 /// The pass over one strand's free nodes with the effect switches fixed, and its tally into
-/// the report. Returns [`not_finite`] summed over the velocities it wrote.
+/// the report. Returns 0 if every velocity it wrote is finite, NaN otherwise.
 fn strand_pass<M: Math, const N: usize>(
     setup: &Setup,
     ctx: &StepContext,
@@ -132,8 +132,8 @@ fn strand_pass<M: Math, const N: usize>(
 }
 
 /// Nodes `2 …` of one strand with the effect switches fixed: lines 13–21 for node `i`, then
-/// lines 24–26 for node `i − 1`. Returns what it measured and the sum of [`not_finite`] over
-/// the velocities it wrote.
+/// lines 24–26 for node `i − 1`. Returns what it measured and [`not_finite_sum`] of the
+/// velocities it wrote.
 #[inline(never)]
 fn nodes_of_strand<
     M: Math,
@@ -181,7 +181,7 @@ fn node_loop<M: Math, const N: usize>(
     let x1 = state.position[1];
     let mut chain = Chain::start(&setup, root_tangent.into(), root_normal.into(), x1.into());
     let mut measures = Measures::default();
-    let mut poison: Real = 0.0;
+    let mut velocity_total: Real = 0.0;
     let mut previous_contact = false;
     for i in 2..n {
         let node = NodeInput::of_strand(rest, state, i, extra(i));
@@ -190,18 +190,18 @@ fn node_loop<M: Math, const N: usize>(
         let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
         // Lines 24–26 for node i − 1, now that node i's correction is known.
         if i > 2 {
-            poison += finish_node(&setup, state, i - 1, chain.position, next.correction);
+            velocity_total += finish_node(&setup, state, i - 1, chain.position, next.correction);
         }
         chain = next.chain;
         previous_contact = next.contact;
     }
     // The last node: no correction (eq. 14 has no node n).
-    poison += finish_node(&setup, state, n - 1, chain.position, V3::zero());
-    (measures, poison)
+    velocity_total += finish_node(&setup, state, n - 1, chain.position, V3::zero());
+    (measures, not_finite_sum(velocity_total))
 }
 
 /// Lines 24–26 for node `i` of one strand: its velocity with the next node's correction,
-/// `x ← x*`. Returns [`not_finite`] of the velocity.
+/// `x ← x*`. Returns the [`component_sum`] of the velocity.
 #[inline(always)]
 fn finish_node<const N: usize>(
     setup: &Setup,
@@ -213,7 +213,7 @@ fn finish_node<const N: usize>(
     let (x_new, v_new) = velocity::finish(setup, x_star, state.position[i].into(), next_correction);
     state.position[i] = x_new.into();
     state.velocity[i] = v_new.into();
-    not_finite(v_new)
+    component_sum(v_new)
 }
 
 /// SB15 Algorithm 1 lines 13–21 for node `i` of every lane (a lane where the node is not
@@ -351,11 +351,12 @@ struct Carried<'a, const W: usize> {
     previous_contact: &'a mut WideMask<W>,
     measures: &'a mut Measures<Wide<W>>,
     collider_push: &'a mut ColliderPush<Wide<W>>,
-    poison: &'a mut Wide<W>,
+    velocity_total: &'a mut Wide<W>,
 }
 
 /// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
-/// tally into the report. Returns [`not_finite`] summed over the velocities each lane wrote.
+/// tally into the report. Returns, per lane, 0 if every velocity it wrote is finite, NaN
+/// otherwise ([`not_finite_sum`]).
 #[inline(never)]
 fn block_pass<
     M: Math,
@@ -373,9 +374,9 @@ fn block_pass<
 ) -> Wide<W> {
     let setup = setup.with_switches(SHAPE, INEXTENSIBLE, DRAG);
     let max_nodes = block.max_nodes.min(N);
-    let mut poison = Wide::splat(0.0);
+    let mut velocity_total = Wide::splat(0.0);
     if max_nodes < 3 {
-        return poison;
+        return velocity_total;
     }
     let nodes = block.nodes;
     let nodes_real = Wide(core::array::from_fn(|l| nodes[l] as Real));
@@ -402,7 +403,7 @@ fn block_pass<
             previous_contact: &mut previous_contact,
             measures: &mut measures,
             collider_push: &mut collider_push,
-            poison: &mut poison,
+            velocity_total: &mut velocity_total,
         };
         // Node 2 finishes nothing (node 1 is held) and past the shortest lane the masks
         // select: both take the masked copy, so the pass holds two copies of a node, not four.
@@ -415,7 +416,7 @@ fn block_pass<
     }
     // The last node of the longest lanes: no correction.
     let longest = WideMask(core::array::from_fn(|l| nodes[l] == max_nodes));
-    poison = poison
+    velocity_total = velocity_total
         + finish_lanes(
             &setup,
             block,
@@ -425,7 +426,7 @@ fn block_pass<
             V3::zero(),
         );
     tally_lanes::<M, W, N>(ctx, &setup, block, &measures, &collider_push, report);
-    poison
+    not_finite_sum(velocity_total)
 }
 
 /// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`
@@ -470,14 +471,16 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     let next_correction = V3::select(active, next.correction, V3::zero());
     let x_star = carried.chain.position;
     let written = finish_lanes(setup, block, k - 1, finishing, x_star, next_correction);
-    *carried.poison = *carried.poison + written;
+    *carried.velocity_total = *carried.velocity_total + written;
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }
 
 /// Lines 24–26 for node `k` of the lanes where `finishing`: the velocity with the next node's
-/// correction, `x ← x*`; the other lanes keep theirs. Returns [`not_finite`] of the
-/// velocities now stored.
+/// correction, `x ← x*`; the other lanes keep theirs. Returns the [`component_sum`] of the
+/// velocities written, 0 in the other lanes (whose velocities the last guard saw finite): each
+/// lane's total adds its strand's per-strand terms in the same order, and zeros, which change
+/// no verdict.
 #[inline(always)]
 fn finish_lanes<const W: usize, const N: usize>(
     setup: &Setup,
@@ -491,7 +494,8 @@ fn finish_lanes<const W: usize, const N: usize>(
         return Wide::splat(0.0);
     };
     let (x_new, v_new) = velocity::finish(setup, x_star, old_position, next_correction);
-    not_finite(block.store_node_where(k, finishing, x_new, v_new))
+    let stored = block.store_node_where(k, finishing, x_new, v_new);
+    Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
 }
 
 /// Each lane's tally into the report, in lane order.

@@ -139,6 +139,19 @@ fn the_rod_runs_its_stages_in_order() {
     }
 }
 
+/// Three curved strands of 8, 9 and 10 nodes side by side.
+fn add_three_strands(world: &mut World<3, 16, Libm>) {
+    for s in 0..3 {
+        let points: [Vec3; 10] = core::array::from_fn(|i| {
+            let i = i as Real;
+            Vec3::new(0.002 * i * i * 0.1, 0.05 + 0.01 * i, 0.01 * s as Real)
+        });
+        world
+            .add_strand(Strand::from_polyline(&points[..8 + s], &Material::HUMAN_HAIR).unwrap())
+            .unwrap();
+    }
+}
+
 const DFTL: [Stage; 9] = [
     Stage::Snapshot,
     Stage::ExternalForces,
@@ -176,15 +189,7 @@ fn dftl_runs_its_stages_in_order_per_strand_and_in_blocks() {
             attached_to_head: true,
         })
         .unwrap();
-    for s in 0..3 {
-        let points: [Vec3; 10] = core::array::from_fn(|i| {
-            let i = i as Real;
-            Vec3::new(0.002 * i * i * 0.1, 0.05 + 0.01 * i, 0.01 * s as Real)
-        });
-        world
-            .add_strand(Strand::from_polyline(&points[..8 + s], &Material::HUMAN_HAIR).unwrap())
-            .unwrap();
-    }
+    add_three_strands(&mut world);
     let mut blocks: [DftlBlock<2, 16>; 2] = [
         DftlBlock::from_strands(&world.strands()[..2]),
         DftlBlock::from_strands(&world.strands()[2..]),
@@ -207,5 +212,65 @@ fn dftl_runs_its_stages_in_order_per_strand_and_in_blocks() {
         previous = head;
         check_order(&block_report, &DFTL, &std::format!("DFTL blocks, step {k}"));
         assert_eq!(report.stage_runs, block_report.stage_runs);
+    }
+}
+
+#[test]
+fn dftl_rolls_back_the_same_strands_per_strand_and_in_blocks() {
+    let params = Params {
+        solver: Solver::Dftl,
+        effects: Effects::from_slice(&[Effect::Gravity, Effect::Shape, Effect::Inextensibility]),
+        ..Params::DEFAULT
+    };
+    let mut world: World<3, 16, Libm> = World::with_params(params).unwrap();
+    add_three_strands(&mut world);
+    let mut blocks: [DftlBlock<2, 16>; 2] = [
+        DftlBlock::from_strands(&world.strands()[..2]),
+        DftlBlock::from_strands(&world.strands()[2..]),
+    ];
+    let mut from_blocks = world.strands().to_vec();
+    let coefficients = params.dftl.at_step(params.dt);
+    let mut accelerations = [Vec3::ZERO; 3 * 16];
+    for k in 0..40u32 {
+        // Step 20: a NaN in strand 1 and an infinity in strand 2 (each rolled back). Step 30:
+        // a huge but finite push on strand 0 (its velocities stay finite: kept).
+        accelerations.fill(Vec3::ZERO);
+        let expected = match k {
+            20 => {
+                accelerations[16 + 5].x = Real::NAN;
+                accelerations[2 * 16 + 4].y = Real::INFINITY;
+                2
+            }
+            30 => {
+                accelerations[6].z = 1.0e30;
+                0
+            }
+            _ => 0,
+        };
+        let report = world.step(&StepInput {
+            head: Pose::IDENTITY,
+            accelerations: Some(&accelerations),
+        });
+        assert_eq!(report.rolled_back, expected, "per strand, step {k}");
+        let ctx = StepContext::with_coefficients(
+            &params,
+            coefficients,
+            Pose::IDENTITY,
+            Pose::IDENTITY,
+            &[],
+        );
+        let mut block_report = StepReport::default();
+        let a = Some(&accelerations[..]);
+        dftl::step_blocks::<Libm, 2, 16>(&ctx, &mut blocks, 0, a, &mut block_report);
+        assert_eq!(block_report.rolled_back, expected, "blocks, step {k}");
+        blocks[0].store(&mut from_blocks[..2]);
+        blocks[1].store(&mut from_blocks[2..]);
+        for (s, (one, lane)) in world.strands().iter().zip(&from_blocks).enumerate() {
+            assert_eq!(
+                one.state.position, lane.state.position,
+                "strand {s}, step {k}"
+            );
+            assert!(one.positions().iter().all(|x| x.is_finite()));
+        }
     }
 }
