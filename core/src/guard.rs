@@ -5,8 +5,8 @@
 //!
 //! One stage for every path ([`guard`]): the rod judges a strand after its step
 //! ([`sound`]); DFTL watches every value it writes during its pass and hands the guard its
-//! verdict per strand or per lane ([`crate::lane::not_finite`] for the root nodes, and
-//! [`crate::lane::not_finite_sum`] of the pass's velocity total).
+//! verdict per strand or per lane ([`crate::lane::not_finite_sum`] of the velocities it
+//! wrote).
 
 use crate::math::Real;
 use crate::report::{Stage, StepReport};

@@ -422,24 +422,16 @@ impl From<Q<Real>> for Quat {
     }
 }
 
-/// 0 where every component of `v` is finite, NaN otherwise (`x − x`): summed over the
-/// velocities a step writes, it is the whole verdict of the DFTL guard.
+/// `x + y + z` of `v`. Summed over the velocities a DFTL step writes (the root coupling's and
+/// the pass's), the total is finite exactly when they all are, short of overflow, so
+/// [`not_finite_sum`] of it is the whole verdict of the DFTL guard: three additions a node. An
+/// overflowing total means a velocity beyond ~10³⁶ m/s: a blow-up, rolled back all the same.
 ///
 /// Velocities only: a node's new velocity is `(x* − x)/Δt − (s_d/Δt) c` (or
 /// `(target − x)/Δt` for a held node), and with `x` finite (the last step's guard saw to
 /// that) and `1/Δt` finite and positive, a non-finite `x*` makes it non-finite too (`±∞` stays
 /// `±∞` or meets `∓∞` and turns NaN; NaN stays NaN) — so the positions need no check of their
 /// own, and a non-finite old `x` is caught the same way. DFTL writes no twist.
-#[inline(always)]
-#[allow(clippy::eq_op)] // x − x is the point: 0 for finite x, NaN for ±∞ and NaN.
-pub fn not_finite<T: Lane>(v: V3<T>) -> T {
-    (v.x - v.x) + (v.y - v.y) + (v.z - v.z)
-}
-
-/// `x + y + z` of `v`. Summed over the velocities a DFTL pass writes, the total is finite
-/// exactly when they all are (short of overflow), so [`not_finite_sum`] of it is the pass's
-/// verdict: three additions a node, where [`not_finite`] takes five operations. An overflowing
-/// total means a velocity beyond ~10³⁶ m/s: a blow-up, which the guard rolls back all the same.
 #[inline(always)]
 pub fn component_sum<T: Lane>(v: V3<T>) -> T {
     v.x + v.y + v.z

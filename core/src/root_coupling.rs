@@ -10,7 +10,7 @@
 
 use crate::context::StepContext;
 use crate::frames::{angle_in_frame, rest_root_frame, transport_in_time, unwrap_near};
-use crate::lane::{not_finite, Lane, Q, V3};
+use crate::lane::{component_sum, Lane, Q, V3};
 use crate::math::{Math, Vec3};
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
@@ -62,7 +62,7 @@ pub fn held_node<T: Lane>(head: &Head<T>, rest_position: V3<T>, position: V3<T>)
 }
 
 /// The root coupling stage: nodes 0 and 1 of `roots` follow the head. Returns
-/// [`not_finite`] summed over the two velocities it wrote, per lane (0 while finite), for a
+/// the [`component_sum`] of the two velocities it wrote, added, per lane, for a
 /// solver that watches what it writes.
 #[inline(always)]
 pub fn root_coupling<R: Roots>(
@@ -72,14 +72,14 @@ pub fn root_coupling<R: Roots>(
 ) -> R::Lane {
     report.ran_on(Stage::RootCoupling, roots.count());
     let head = Head::of(ctx);
-    let mut poison = R::Lane::splat(0.0);
+    let mut velocity_total = R::Lane::splat(0.0);
     for i in 0..2 {
         let (rest_position, position) = roots.held(i);
         let (target, velocity) = held_node(&head, rest_position, position);
         roots.set_held(i, target, velocity);
-        poison = poison + not_finite(velocity);
+        velocity_total = velocity_total + component_sum(velocity);
     }
-    poison
+    velocity_total
 }
 
 impl<const N: usize> Roots for Strand<N> {

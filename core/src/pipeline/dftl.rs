@@ -77,7 +77,7 @@ pub fn step_strand<M: Math, const N: usize>(
     count_constraints(setup, 1, report);
     let pass = strand_pass::<M, N>(setup, ctx, strand, accelerations, report);
     // Quarantine: every value written finite, or the last good positions back.
-    let good = roots + pass == 0.0;
+    let good = not_finite_sum(roots + pass) == 0.0;
     guard(strand, &last_good, |_, _| good, index, report);
 }
 
@@ -106,7 +106,7 @@ fn count_constraints(setup: &Setup, strands: u32, report: &mut StepReport) {
 }
 
 /// The pass over one strand's free nodes with the effect switches fixed, and its tally into
-/// the report. Returns 0 if every velocity it wrote is finite, NaN otherwise.
+/// the report. Returns the [`component_sum`]s of the velocities it wrote, added.
 fn strand_pass<M: Math, const N: usize>(
     setup: &Setup,
     ctx: &StepContext,
@@ -119,7 +119,7 @@ fn strand_pass<M: Math, const N: usize>(
     }
     let colliders = ctx.colliders();
     let mut collider_push = [V3::zero(); MAX_COLLIDERS];
-    let (measures, poison) = with_effect_switches!(
+    let (measures, velocity_total) = with_effect_switches!(
         setup,
         nodes_of_strand::<M, N>(setup, strand, colliders, accelerations, &mut collider_push)
     );
@@ -128,12 +128,12 @@ fn strand_pass<M: Math, const N: usize>(
         colliders.len(),
         setup.inv_dt,
     );
-    poison
+    velocity_total
 }
 
 /// Nodes `2 …` of one strand with the effect switches fixed: lines 13–21 for node `i`, then
-/// lines 24–26 for node `i − 1`. Returns what it measured and [`not_finite_sum`] of the
-/// velocities it wrote.
+/// lines 24–26 for node `i − 1`. Returns what it measured and the [`component_sum`]s of the
+/// velocities it wrote, added.
 #[inline(never)]
 fn nodes_of_strand<
     M: Math,
@@ -197,7 +197,7 @@ fn node_loop<M: Math, const N: usize>(
     }
     // The last node: no correction (eq. 14 has no node n).
     velocity_total += finish_node(&setup, state, n - 1, chain.position, V3::zero());
-    (measures, not_finite_sum(velocity_total))
+    (measures, velocity_total)
 }
 
 /// Lines 24–26 for node `i` of one strand: its velocity with the next node's correction,
@@ -335,11 +335,11 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
         block_pass::<M, W, N>(ctx, &setup, block, accelerations, report)
     );
     // Quarantine: a lane that wrote a non-finite value gets its last good positions back.
-    let poison = roots + pass;
+    let verdict = not_finite_sum(roots + pass);
     guard(
         block,
         &last_good,
-        |_, l| poison.0[l] == 0.0,
+        |_, l| verdict.0[l] == 0.0,
         first_strand,
         report,
     );
@@ -355,8 +355,8 @@ struct Carried<'a, const W: usize> {
 }
 
 /// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
-/// tally into the report. Returns, per lane, 0 if every velocity it wrote is finite, NaN
-/// otherwise ([`not_finite_sum`]).
+/// tally into the report. Returns, per lane, the [`component_sum`]s of the velocities it
+/// wrote, added.
 #[inline(never)]
 fn block_pass<
     M: Math,
@@ -426,7 +426,7 @@ fn block_pass<
             V3::zero(),
         );
     tally_lanes::<M, W, N>(ctx, &setup, block, &measures, &collider_push, report);
-    not_finite_sum(velocity_total)
+    velocity_total
 }
 
 /// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`
