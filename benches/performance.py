@@ -980,7 +980,9 @@ An absolute figure belongs to the machine it was measured on, described first; t
 may differ from one run of the command to the next. The ratios (hair-optimised ÷ Newton, with ÷
 without collisions, blocks ÷ per-strand, two threads ÷ one, DFTL + shape ÷ DFTL, hair–hair ÷
 none, the share of the memory bandwidth) depend far less on it: compare those across runs. Each
-section names the bench that gives it, to reproduce one table alone."""
+section names the bench that gives it, to reproduce one table alone. Two versions of the code
+are compared, old against new alternated in one sitting, by `python3 benches/compare.py --old
+OLD-CHECKOUT` (every criterion row, the median of the per-round ratios)."""
 
 
 def machine_section(args, cpu, rustc, load_start, load_end, bandwidth, wall, build):
