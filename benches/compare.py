@@ -23,22 +23,17 @@ Python 3 standard library only. Progress goes to stderr, the table to stdout.
 """
 
 import argparse
-import json
 import re
 import statistics
 import subprocess
 import sys
-import time
 from pathlib import Path
+
+from performance import bench_executables, cpu_info, log
 
 ROOT = Path(__file__).resolve().parent.parent
 CRITERION_BENCHES = ["dftl", "effects", "rod_projection", "rod_twist", "step"]
 UNIT = {"ps": 1e-12, "ns": 1e-9, "µs": 1e-6, "us": 1e-6, "ms": 1e-3, "s": 1.0}
-START = time.time()
-
-
-def log(message):
-    print(f"[{time.time() - START:6.0f} s] {message}", file=sys.stderr, flush=True)
 
 
 def build(checkout, benches):
@@ -50,15 +45,7 @@ def build(checkout, benches):
     result = subprocess.run(command, cwd=checkout, capture_output=True, text=True)
     if result.returncode != 0:
         sys.exit(f"cargo bench --no-run failed in {checkout}:\n{result.stderr[-3000:]}")
-    found = {}
-    for line in result.stdout.splitlines():
-        try:
-            message = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        target = message.get("target", {})
-        if message.get("executable") and "bench" in target.get("kind", []):
-            found[target["name"]] = message["executable"]
+    found = bench_executables(result.stdout)
     missing = [b for b in benches if b not in found]
     if missing:
         sys.exit(f"{checkout}: no executable for {', '.join(missing)}")
@@ -135,19 +122,6 @@ def format_time(seconds):
     return f"{seconds / 1e-9:.1f} ns"
 
 
-def cpu_model():
-    """The CPU's model name with its family and model numbers (a VM may name only the vendor)."""
-    fields = {}
-    try:
-        for line in open("/proc/cpuinfo"):
-            key, _, value = line.partition(":")
-            fields.setdefault(key.strip(), value.strip())
-    except OSError:
-        return "unknown CPU"
-    return (f"{fields.get('model name', 'unknown CPU')} (family {fields.get('cpu family', '?')}, "
-            f"model {fields.get('model', '?')})")
-
-
 SAMPLE = """Benchmarking dftl 1024 x 8/per-strand/dftl: Analyzing
 dftl 1024 x 8/per-strand/dftl
                         time:   [126.01 µs 128.62 µs 131.20 µs]
@@ -190,7 +164,8 @@ def main():
     if unknown:
         sys.exit(f"not a criterion bench: {', '.join(unknown)} "
                  f"(choose from {', '.join(CRITERION_BENCHES)})")
-    cpu = cpu_model()
+    info = cpu_info()
+    cpu = f"{info['model']} (family {info['family']}, model {info['model_number']})"
     old = build(args.old.resolve(), benches)
     new = build(args.new.resolve(), benches)
     print(f"# Old ({args.old}) against new ({args.new}), alternated\n")

@@ -168,6 +168,21 @@ def table(header, rows, align=None):
 # The machine
 
 
+def bench_executables(cargo_json):
+    """{bench name: executable} from the JSON messages of `cargo bench --no-run
+    --message-format=json…` (where cargo put each bench, never guessed from file times)."""
+    found = {}
+    for line in cargo_json.splitlines():
+        try:
+            message = json.loads(line)
+        except ValueError:
+            continue
+        if message.get("reason") == "compiler-artifact" and message.get("executable") \
+                and "bench" in message["target"]["kind"]:
+            found[message["target"]["name"]] = Path(message["executable"])
+    return found
+
+
 def cpu_info():
     text = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
     fields = {}
@@ -267,14 +282,8 @@ class Runner:
         if rc != 0:
             self.fail("build" + (" (native)" if native else ""), tail(err))
             return False
-        for line in out.splitlines():
-            try:
-                message = json.loads(line)
-            except ValueError:
-                continue
-            if message.get("reason") == "compiler-artifact" and message.get("executable") \
-                    and "bench" in message["target"]["kind"]:
-                self.executables[(message["target"]["name"], native)] = Path(message["executable"])
+        for name, executable in bench_executables(out).items():
+            self.executables[(name, native)] = executable
         return True
 
     def env(self, native=False, criterion_dir=None):
