@@ -146,14 +146,16 @@ fn distance_from_rest<const M: usize>(s: &Strand<M>) -> Real {
 
 /// With the global shape constraint on (`s_g` = 0.1 at 16 ms, `s_l` = 0, `s_d` = 0) and no
 /// gravity, wavy and curly strands pushed sideways for 0.2 s (16 m/s²) return to their rest
-/// shape: within 0.5 mm of every rest node 3 s later (measured: pushed 4.6 mm away, 1.8 µm left
-/// after 3 s). With the shape constraints off, under gravity the same strands hang: their tips
+/// shape: within 0.5 mm of every rest node 3 s later (measured: pushed 3.0 mm away — 4.6 mm
+/// before the shape damping, which resists motion relative to the head as the 60 Hz
+/// projection does — and 1.8 µm left after 3 s). With the shape constraints off, under gravity the same strands hang: their tips
 /// drop by more than 5 cm (measured 18–36 cm).
 ///
 /// With the paper's defaults (`s_g` = 0.1, `s_l` = 0.3 at 16 ms, `s_d` = 0.9) the same strands
-/// come back to within 3 cm after 3 s (measured 2.3 cm; 3–7 cm when eq. (14) also fed back the
-/// global correction, see `core/src/dftl/velocity.rs`): the one-sided local constraint keeps
-/// some motion going, slowly. Asserted: within 3 cm.
+/// come back as well: 1.2 µm from rest after 3 s. Before the local correction's reaction
+/// became a bending stencil and the shape damping came in (`core/src/dftl/velocity.rs`,
+/// `damping.rs`) they stayed 2.3 cm away (3–7 cm when eq. (14) also fed back the global
+/// correction): SB15's one-sided reaction kept a zig-zag going. Asserted: within 0.5 mm.
 #[test]
 fn shape_constraints_bring_styled_strands_back() {
     let mut p = dftl(&[Effect::Shape, Effect::Inextensibility]);
@@ -176,7 +178,7 @@ fn shape_constraints_bring_styled_strands_back() {
         .iter()
         .map(distance_from_rest)
         .fold(0.0, Real::max);
-    assert!(disturbed > 0.004, "the push did not disturb: {disturbed}");
+    assert!(disturbed > 0.002, "the push did not disturb: {disturbed}");
     for _ in 0..3000 {
         w.step(&still);
     }
@@ -204,7 +206,7 @@ fn shape_constraints_bring_styled_strands_back() {
         .map(distance_from_rest)
         .fold(0.0, Real::max);
     println!("paper defaults: {bounded} m from the rest shape after 3 s");
-    assert!(bounded < 0.03, "{bounded}");
+    assert!(bounded < 5e-4, "{bounded}");
 
     let mut hanging = world::<Libm>(dftl(&[Effect::Gravity, Effect::Inextensibility]), 8, N);
     for _ in 0..2000 {

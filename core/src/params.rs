@@ -96,18 +96,26 @@ impl DftlParams {
     /// `s_d` is a fraction of the correction fed back and is not rescaled.
     #[must_use]
     pub fn at_step(&self, dt: Real) -> DftlCoefficients {
+        let local_shape = crate::math::relaxation_at_step(self.local_shape, dt, self.reference_dt);
         DftlCoefficients {
             damping: self.damping,
             global_shape: crate::math::relaxation_at_step(self.global_shape, dt, self.reference_dt),
-            local_shape: crate::math::relaxation_at_step(self.local_shape, dt, self.reference_dt),
+            local_shape,
             global_shape_fade: self.global_shape_fade,
             local_shape_fade: self.local_shape_fade,
+            bending_reaction: 0.5 * (1.0 - local_shape),
+            shape_retention: crate::math::shape_damping_retention(
+                self.global_shape,
+                self.local_shape,
+                self.reference_dt,
+                dt,
+            ),
         }
     }
 }
 
 /// DFTL's coefficients at the world's step (see [`DftlParams::at_step`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct DftlCoefficients {
     /// `s_d`, as given.
@@ -120,6 +128,31 @@ pub struct DftlCoefficients {
     pub global_shape_fade: Real,
     /// As [`DftlParams::local_shape_fade`].
     pub local_shape_fade: Real,
+    /// `φ = (1 − s_l)/2`: the share of the local correction's reaction handed to the node
+    /// before the previous one, as a bending stencil (`dftl::velocity`).
+    pub bending_reaction: Real,
+    /// `r`, the per-step velocity retention of the shape damping (`dftl::damping`); 1 at and
+    /// above 60 Hz.
+    pub shape_retention: Real,
+}
+
+impl DftlCoefficients {
+    /// No DFTL: every coefficient 0, no damping (`r` = 1).
+    pub const NONE: DftlCoefficients = DftlCoefficients {
+        damping: 0.0,
+        global_shape: 0.0,
+        local_shape: 0.0,
+        global_shape_fade: 0.0,
+        local_shape_fade: 0.0,
+        bending_reaction: 0.0,
+        shape_retention: 1.0,
+    };
+}
+
+impl Default for DftlCoefficients {
+    fn default() -> Self {
+        Self::NONE
+    }
 }
 
 /// Wind, an external acceleration on every free node of both solvers (used when `wind` is on):

@@ -53,13 +53,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     pub const fn new() -> Self {
         World {
             params: Params::DEFAULT,
-            dftl: DftlCoefficients {
-                damping: 0.0,
-                global_shape: 0.0,
-                local_shape: 0.0,
-                global_shape_fade: 0.0,
-                local_shape_fade: 0.0,
-            },
+            dftl: DftlCoefficients::NONE,
             strands: heapless::Vec::new(),
             colliders: heapless::Vec::new(),
             grabs: heapless::Vec::new(),

@@ -247,22 +247,28 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
         })
     }
 
-    /// Node `k`'s position and velocity, set where `mask` and left as they are in the other
-    /// lanes. Returns the velocity now stored (zero past the capacity).
+    /// Node `k`'s position, set where `mask` and left as it is in the other lanes.
     #[inline(always)]
-    pub fn store_node_where(
+    pub fn store_position_where(&mut self, k: usize, mask: WideMask<W>, position: V3<Wide<W>>) {
+        if let Some(state) = self.state.get_mut(k) {
+            let position = V3::select(mask, position, read_lanes(&state.position));
+            write_lanes(&mut state.position, position);
+        }
+    }
+
+    /// Node `k`'s velocity, set where `mask` and left as it is in the other lanes. Returns the
+    /// velocity now stored (zero past the capacity).
+    #[inline(always)]
+    pub fn store_velocity_where(
         &mut self,
         k: usize,
         mask: WideMask<W>,
-        position: V3<Wide<W>>,
         velocity: V3<Wide<W>>,
     ) -> V3<Wide<W>> {
         let Some(state) = self.state.get_mut(k) else {
             return V3::zero();
         };
-        let position = V3::select(mask, position, read_lanes(&state.position));
         let velocity = V3::select(mask, velocity, read_lanes(&state.velocity));
-        write_lanes(&mut state.position, position);
         write_lanes(&mut state.velocity, velocity);
         velocity
     }

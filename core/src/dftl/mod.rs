@@ -8,20 +8,23 @@
 //!
 //! | line  | stage | file |
 //! |---|---|---|
+//! | (14)  | shape damping: the velocity relative to the head's rigid motion | [`damping`] |
 //! | 13–14 | external accelerations, prediction `x* = x + vΔt + aΔt²` | [`predict`] |
 //! | 18    | global then local shape, eqs. (8)–(9) | [`shape`] |
 //! | 19    | follow-the-leader inextensibility, eq. (10) | [`follow_leader`] |
 //! | 20    | push out of colliders (not in the correction) | [`collisions`] |
 //! | 21    | frame update | [`frame`] |
-//! | 24–26 | velocity with the `s_d` correction, eq. (14); `x ← x*` | [`velocity`] |
+//! | 24–26 | velocity with the `s_d` reaction, eq. (14); `x ← x*` | [`velocity`] |
 //!
-//! Lines 24–26 run one node behind (node `i − 1` is finished as soon as node `i`'s correction
-//! is known), so a step is a single pass whose cost is fixed by the scene.
+//! Lines 24–26 run two nodes behind (node `i − 2` is finished as soon as node `i`'s
+//! corrections are known), so a step is a single pass whose cost is fixed by the scene.
 //!
-//! Eq. (14)'s velocity correction feeds back the local-shape and follow-the-leader
-//! corrections of the next node, not the global one: [`velocity`] says why and what was
-//! measured. With inextensibility only, `s_d = 0.9` removes the energy plain FTL pumps in (78 %
-//! of a swing's energy lost in 2 s, vs. plain FTL gaining up to 70×).
+//! Eq. (14)'s velocity correction feeds back the follow-the-leader correction of the next
+//! node and the local-shape corrections of the next two, as a bending stencil, not the global
+//! one: [`velocity`] says why and what was measured. With inextensibility only, `s_d = 0.9`
+//! removes the energy plain FTL pumps in (78 % of a swing's energy lost in 2 s, vs. plain FTL
+//! gaining up to 70×). Below 60 Hz the shape damping ([`damping`]) adds the dissipation the
+//! shape projection loses with a smaller step.
 //!
 //! Frames are carried as tangent and normal vectors ([`frame`]): with the tangent taken from
 //! the follow-the-leader step, a node costs one square root and, with shape, two divisions;
@@ -36,6 +39,7 @@
 
 pub mod block;
 pub mod collisions;
+pub mod damping;
 pub mod follow_leader;
 pub mod frame;
 pub mod measures;

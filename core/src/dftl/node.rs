@@ -37,6 +37,13 @@ pub struct Setup {
     pub head_rotation: Mat3,
     /// The head's translation.
     pub head_position: Vec3,
+    /// Whether the shape damping runs (`dftl::damping`): shape on and `r` < 1.
+    pub shape_damping: bool,
+    /// `(1 − r) ω`: the head's rigid velocity at `x` is `ω × (x − t_head) + ṫ`
+    /// (`dftl::damping`).
+    pub damping_spin: Vec3,
+    /// `(1 − r)(ṫ − ω × t_head)`, `ṫ = (t_head − t_prev)/Δt`.
+    pub damping_offset: Vec3,
 }
 
 impl Setup {
@@ -44,6 +51,8 @@ impl Setup {
     /// passes are specialised for (`shape`, `inextensibility`, `drag`) and `collisions`.
     #[must_use]
     pub fn new(ctx: &StepContext) -> Self {
+        let head_rotation = Mat3::from_quat(ctx.head.rotation);
+        let (damping_spin, damping_offset) = damping_terms(ctx, head_rotation);
         Setup {
             dt: ctx.dt,
             dt_squared: ctx.dt * ctx.dt,
@@ -56,8 +65,11 @@ impl Setup {
             inextensibility: ctx.gates.inextensibility,
             collisions: ctx.gates.colliders,
             coefficients: ctx.dftl,
-            head_rotation: Mat3::from_quat(ctx.head.rotation),
+            head_rotation,
             head_position: ctx.head.position,
+            shape_damping: ctx.gates.shape && ctx.dftl.shape_retention < 1.0,
+            damping_spin,
+            damping_offset,
         }
     }
 
@@ -82,6 +94,26 @@ impl Setup {
             + V3::splat(r.y_axis).scale(v.y)
             + V3::splat(r.z_axis).scale(v.z)
     }
+}
+
+/// `(1 − r) ω` and `(1 − r)(ṫ − ω × t)` of [`Setup`], once per step. Over the step the head
+/// carries a point `x` from `R_prev R_headᵀ (x − t) + t_prev`: its velocity is
+/// `A (x − t)/Δt + ṫ` with `A = I − R_prev R_headᵀ`, and `A` is `[θ]×` (`θ = ω Δt`, the turn of
+/// the step) up to `O(θ²)`; `ω` is read from its antisymmetric part (no trigonometry).
+fn damping_terms(ctx: &StepContext, head_rotation: Mat3) -> (Vec3, Vec3) {
+    let pull = 1.0 - ctx.dftl.shape_retention;
+    let carried_back = Mat3::from_quat(ctx.previous_head.rotation) * head_rotation.transpose();
+    let a = Mat3::IDENTITY - carried_back;
+    // [θ]× has θ_x at (2,1) and −θ_x at (1,2): columns are glam's axes.
+    let theta = Vec3::new(
+        a.y_axis.z - a.z_axis.y,
+        a.z_axis.x - a.x_axis.z,
+        a.x_axis.y - a.y_axis.x,
+    ) * 0.5;
+    let spin = theta * ctx.inv_dt;
+    let head_velocity = (ctx.head.position - ctx.previous_head.position) * ctx.inv_dt;
+    let offset = head_velocity - spin.cross(ctx.head.position);
+    (spin * pull, offset * pull)
 }
 
 /// One free node's inputs (per lane): its state at the start of the step and its rest data.
@@ -176,15 +208,17 @@ impl<T: Lane> Chain<T> {
     }
 }
 
-/// What one node hands on: the chain at this node (its final position and frame),
-/// `Δx^lcl_i + Δx^inex_i`, fed back into node `i − 1`'s velocity (eq. 14), and whether a
-/// collider pushed it.
+/// What one node hands on: the chain at this node (its final position and frame), its
+/// local-shape and follow-the-leader corrections, whose reactions go to the two nodes before
+/// it (eq. 14, `dftl::velocity`), and whether a collider pushed it.
 #[derive(Clone, Copy, Debug)]
 pub struct Advanced<T: Lane> {
     /// The chain at this node.
     pub chain: Chain<T>,
-    /// `Δx^lcl_i + Δx^inex_i`.
-    pub correction: V3<T>,
+    /// `Δx^lcl_i`.
+    pub local: V3<T>,
+    /// `Δx^inex_i`.
+    pub inextensible: V3<T>,
     /// Whether a collider pushed the node (its segment to the next node is then measured as
     /// a segment with contact).
     pub contact: T::Mask,

@@ -5,6 +5,7 @@
 //! | line | Algorithm 1 | stage |
 //! |---|---|---|
 //! | 1–11 | global dynamics (SPH) | the std harness, an input of the step |
+//! | (14) | shape damping below 60 Hz (a departure) | `dftl::damping` |
 //! | 12–15 | each particle after the root: external forces, predict `x*` | `dftl::predict` |
 //! | (12) | the root follows the head | `root_coupling` |
 //! | 18 | shape constraints | `dftl::shape` |
@@ -14,8 +15,8 @@
 //! | 24–26 | velocity with the correction term; `x ← x*` | `dftl::velocity` |
 //!
 //! Lines 12–27 run fused, node by node, in one pass from the root ([`advance`] is lines
-//! 13–21 for one node); lines 24–26 run one node behind, as soon as the next node's
-//! correction is known, so a step is a single pass whose cost is fixed by the scene. The
+//! 13–21 for one node); lines 24–26 run two nodes behind, as soon as the corrections of the
+//! next two nodes are known, so a step is a single pass whose cost is fixed by the scene. The
 //! stages are counted in the algorithm's order: a node's prediction does not depend on the
 //! root coupling of nodes 0 and 1, so predicting first is the same computation. Before and
 //! after the pass, the quarantine every path shares: `snapshot` and `guard`.
@@ -26,7 +27,8 @@ use crate::context::StepContext;
 use crate::dftl::block::{read_lanes, BlockState, DftlBlock};
 use crate::dftl::measures::{ColliderPush, Measures, Tally};
 use crate::dftl::node::{Advanced, Chain, NodeInput, Setup};
-use crate::dftl::{collisions, follow_leader, frame, predict, shape, velocity};
+use crate::dftl::velocity::Pending;
+use crate::dftl::{collisions, damping, follow_leader, frame, predict, shape};
 use crate::guard::guard;
 use crate::lane::{component_sum, not_finite_sum, Lane, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
@@ -183,37 +185,61 @@ fn node_loop<M: Math, const N: usize>(
     let mut measures = Measures::default();
     let mut velocity_total: Real = 0.0;
     let mut previous_contact = false;
+    let mut pending = Pending::start();
     for i in 2..n {
         let node = NodeInput::of_strand(rest, state, i, extra(i));
         // Lines 13–21: predict, shape, follow the leader, collisions, frame.
         let (m, c) = (&mut measures, &mut *collider_push);
         let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
-        // Lines 24–26 for node i − 1, now that node i's correction is known.
-        if i > 2 {
-            velocity_total += finish_node(&setup, state, i - 1, chain.position, next.correction);
+        // Lines 24–26: node i − 1 is final, node i − 2 has its whole reaction.
+        if i >= 3 {
+            let x = state.position[i - 1].into();
+            let (finished, rest_pending) =
+                pending.hand_on(&setup, chain.position, x, next.local, next.inextensible);
+            state.position[i - 1] = chain.position.into();
+            if i >= 4 {
+                state.velocity[i - 2] = finished.into();
+                velocity_total += component_sum(finished);
+            }
+            pending = rest_pending;
         }
         chain = next.chain;
         previous_contact = next.contact;
     }
-    // The last node: no correction (eq. 14 has no node n).
-    velocity_total += finish_node(&setup, state, n - 1, chain.position, V3::zero());
+    // The last two nodes: no node after them (eq. 14 has no node n).
+    let zero = V3::zero();
+    velocity_total += hand_on(&setup, state, (n, n), &mut pending, chain.position);
+    velocity_total += hand_on(&setup, state, (n + 1, n), &mut pending, zero);
     (measures, velocity_total)
 }
 
-/// Lines 24–26 for node `i` of one strand: its velocity with the next node's correction,
-/// `x ← x*`. Returns the [`component_sum`] of the velocity.
+/// Lines 24–26 past the strand's end (`i ≥ n`, zero corrections), as the node loop does
+/// once node `i` is advanced: node `i − 1`'s final position `x_star` is stored (if it exists)
+/// and its velocity pends; node `i − 2`'s velocity, now whole, is stored. Returns the
+/// [`component_sum`] of the velocity stored.
 #[inline(always)]
-fn finish_node<const N: usize>(
+fn hand_on<const N: usize>(
     setup: &Setup,
     state: &mut StrandState<N>,
-    i: usize,
+    (i, n): (usize, usize),
+    pending: &mut Pending<Real>,
     x_star: V3<Real>,
-    next_correction: V3<Real>,
 ) -> Real {
-    let (x_new, v_new) = velocity::finish(setup, x_star, state.position[i].into(), next_correction);
-    state.position[i] = x_new.into();
-    state.velocity[i] = v_new.into();
-    component_sum(v_new)
+    let (local, inextensible) = (V3::zero(), V3::zero());
+    let moving = state.position.get_mut(i - 1).filter(|_| i - 1 < n);
+    let x = moving.as_ref().map_or(x_star, |x| (**x).into());
+    let (finished, next) = pending.hand_on(setup, x_star, x, local, inextensible);
+    if let Some(position) = moving {
+        *position = x_star.into();
+    }
+    *pending = next;
+    match state.velocity.get_mut(i - 2).filter(|_| i >= 4) {
+        Some(velocity) => {
+            *velocity = finished.into();
+            component_sum(finished)
+        }
+        None => 0.0,
+    }
 }
 
 /// SB15 Algorithm 1 lines 13–21 for node `i` of every lane (a lane where the node is not
@@ -231,32 +257,33 @@ pub fn advance<M: Math, T: Lane>(
     measures: &mut Measures<T>,
     collider_push: &mut ColliderPush<T>,
 ) -> Advanced<T> {
+    // Below 60 Hz, the shape damping: the velocity relative to the head's rigid motion.
+    let velocity = if setup.shape && setup.shape_damping {
+        damping::damped_velocity(setup, node.position, node.velocity)
+    } else {
+        node.velocity
+    };
     // Lines 13–14: external accelerations, prediction (eq. 1).
-    let a = predict::acceleration(
-        setup,
-        node.velocity,
-        node.inverse_mass,
-        node.extra,
-        node.has_extra,
-    );
-    let mut x = predict::predicted_position(setup, node.position, node.velocity, a);
+    let a = predict::acceleration(setup, velocity, node.mass, node.extra, node.has_extra);
+    let mut x = predict::predicted_position(setup, node.position, velocity, a);
     // Line 18: shape, eqs. (8), (9) — the local target uses x* after the global step. Eq.
     // (14) feeds back the local and the follow-the-leader corrections, not the global one
     // (`dftl::velocity` says why).
-    let mut correction = V3::zero();
+    let mut local = V3::zero();
     if setup.shape {
         x = x + shape::global_correction(setup, node.rest_position, node.root_distance, x);
         let (previous, tangent, normal) = (chain.position, chain.tangent, chain.normal);
-        let local = (node.local_rest, node.root_distance);
-        correction = shape::local_correction(setup, previous, tangent, normal, local.0, local.1, x);
-        x = x + correction;
+        let rest = (node.local_rest, node.root_distance);
+        local = shape::local_correction(setup, previous, tangent, normal, rest.0, rest.1, x);
+        x = x + local;
     }
     // Line 19: follow the leader, eq. (10); its direction is the frame's next tangent.
     let (mut tangent, mut tangent_known) = (chain.tangent, T::mask(false));
+    let mut inextensible = V3::zero();
     if setup.inextensibility {
         let (projected, t) =
             follow_leader::project::<M, T>(chain.position, x, node.segment_length, chain.tangent);
-        correction = correction + (projected - x);
+        inextensible = projected - x;
         (x, tangent, tangent_known) = (projected, t, T::mask(true));
     }
     // Line 20: collisions, each collider in turn (not part of the correction).
@@ -288,7 +315,8 @@ pub fn advance<M: Math, T: Lane>(
     };
     Advanced {
         chain,
-        correction,
+        local,
+        inextensible,
         contact,
     }
 }
@@ -348,6 +376,7 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
 /// What the node loop of a block carries from node to node.
 struct Carried<'a, const W: usize> {
     chain: &'a mut Chain<Wide<W>>,
+    pending: &'a mut Pending<Wide<W>>,
     previous_contact: &'a mut WideMask<W>,
     measures: &'a mut Measures<Wide<W>>,
     collider_push: &'a mut ColliderPush<Wide<W>>,
@@ -394,43 +423,48 @@ fn block_pass<
     let mut measures: Measures<Wide<W>> = Measures::default();
     let mut collider_push: ColliderPush<Wide<W>> = [V3::zero(); MAX_COLLIDERS];
     let mut previous_contact = Wide::<W>::mask(false);
+    let mut pending = Pending::start();
     // Nodes every lane has: there every lane is active and every selection below is a
     // constant (the same bits as the masked form, without its blends).
     let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
     for k in 2..max_nodes {
         let carried = Carried {
             chain: &mut chain,
+            pending: &mut pending,
             previous_contact: &mut previous_contact,
             measures: &mut measures,
             collider_push: &mut collider_push,
             velocity_total: &mut velocity_total,
         };
-        // Node 2 finishes nothing (node 1 is held) and past the shortest lane the masks
+        // Nodes 2 and 3 finish nothing (node 1 is held) and past the shortest lane the masks
         // select: both take the masked copy, so the pass holds two copies of a node, not four.
         let (b, a, n) = (&mut *block, accelerations, nodes_real);
-        if k > 2 && k < common {
+        if k >= 4 && k < common {
             block_node::<M, W, N, true>(ctx, &setup, b, k, n, a, carried);
         } else {
             block_node::<M, W, N, false>(ctx, &setup, b, k, n, a, carried);
         }
     }
-    // The last node of the longest lanes: no correction.
-    let longest = WideMask(core::array::from_fn(|l| nodes[l] == max_nodes));
-    velocity_total = velocity_total
-        + finish_lanes(
-            &setup,
-            block,
-            max_nodes - 1,
-            longest,
-            chain.position,
-            V3::zero(),
-        );
+    // The last two nodes of the longest lanes: no node after them.
+    for k in max_nodes..max_nodes + 2 {
+        let zero = V3::zero();
+        let (x_star, b) = (chain.position, &mut *block);
+        let (p, at) = (&mut pending, (k, nodes_real));
+        let written = hand_on_lanes(&setup, b, at, p, x_star, (zero, zero));
+        velocity_total = velocity_total + written;
+    }
     tally_lanes::<M, W, N>(ctx, &setup, block, &measures, &collider_push, report);
     velocity_total
 }
 
-/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 1`
-/// where it is free (`k > 2`). With `ALL` every lane has both nodes: the masks are constants.
+/// The lanes where node `k` is free (node 1 is held) and exists.
+#[inline(always)]
+fn free_lanes<const W: usize>(k: usize, nodes_real: Wide<W>) -> WideMask<W> {
+    Wide::splat(k as Real).lt(nodes_real) & Wide::<W>::mask(k >= 2)
+}
+
+/// Node `k` of every lane (SB15 Algorithm 1 lines 13–21) and lines 24–26 for node `k − 2`
+/// where it is free (`k ≥ 4`). With `ALL` every lane has both nodes: the masks are constants.
 #[inline(always)]
 fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     ctx: &StepContext,
@@ -441,18 +475,10 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     accelerations: Option<&[Vec3]>,
     carried: Carried<'_, W>,
 ) {
-    let node_index = Wide::splat(k as Real);
-    let (active, finishing) = if ALL {
-        (Wide::<W>::mask(true), Wide::<W>::mask(true))
+    let active = if ALL {
+        Wide::<W>::mask(true)
     } else {
-        // Node k − 1 exists in this lane and is free (node 1 is held): it is finished now. A
-        // lane not finishing keeps its node as it is, so node 2 gives the bits of a pass that
-        // finishes nothing there.
-        let free = Wide::<W>::mask(k > 2);
-        (
-            node_index.lt(nodes_real),
-            (node_index - Wide::splat(1.0)).lt(nodes_real) & free,
-        )
+        Wide::splat(k as Real).lt(nodes_real)
     };
     let Some(node) = block.node_input(k, active, accelerations) else {
         return;
@@ -467,35 +493,76 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
         carried.measures,
         carried.collider_push,
     );
-    // Lines 24–26 for node k − 1; the last node of a lane (k == nodes) gets no correction.
-    let next_correction = V3::select(active, next.correction, V3::zero());
+    // Lines 24–26 for nodes k − 1 and k − 2; a lane past its last node hands on zeros, as
+    // the per-strand path does after a strand's last node.
+    let local = V3::select(active, next.local, V3::zero());
+    let inextensible = V3::select(active, next.inextensible, V3::zero());
     let x_star = carried.chain.position;
-    let written = finish_lanes(setup, block, k - 1, finishing, x_star, next_correction);
+    let written = if ALL {
+        hand_on_every_lane(
+            setup,
+            block,
+            k,
+            carried.pending,
+            x_star,
+            (local, inextensible),
+        )
+    } else {
+        let (pending, at) = (&mut *carried.pending, (k, nodes_real));
+        hand_on_lanes(setup, block, at, pending, x_star, (local, inextensible))
+    };
     *carried.velocity_total = *carried.velocity_total + written;
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }
 
-/// Lines 24–26 for node `k` of the lanes where `finishing`: the velocity with the next node's
-/// correction, `x ← x*`; the other lanes keep theirs. Returns the [`component_sum`] of the
-/// velocities written, 0 in the other lanes (whose velocities the last guard saw finite): each
-/// lane's total adds its strand's per-strand terms in the same order, and zeros, which change
-/// no verdict.
+/// Lines 24–26 once node `k` of every lane is advanced (or, past a lane's end, with zero
+/// corrections), as the per-strand path's `hand_on`: node `k − 1`'s final position `x_star`
+/// is stored where it is free, and node `k − 2`'s velocity where it is free. Returns the
+/// [`component_sum`] of the velocities stored, 0 in the other lanes (whose velocities the
+/// last guard saw finite): each lane's total adds its strand's per-strand terms in the same
+/// order, and zeros, which change no verdict.
 #[inline(always)]
-fn finish_lanes<const W: usize, const N: usize>(
+fn hand_on_lanes<const W: usize, const N: usize>(
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    (k, nodes_real): (usize, Wide<W>),
+    pending: &mut Pending<Wide<W>>,
+    x_star: V3<Wide<W>>,
+    (local, inextensible): (V3<Wide<W>>, V3<Wide<W>>),
+) -> Wide<W> {
+    let (moving, finishing) = (free_lanes(k - 1, nodes_real), free_lanes(k - 2, nodes_real));
+    let x = block
+        .state
+        .get(k - 1)
+        .map_or(x_star, |s| read_lanes(&s.position));
+    let x = V3::select(moving, x, x_star);
+    let (finished, next) = pending.hand_on(setup, x_star, x, local, inextensible);
+    block.store_position_where(k - 1, moving, x_star);
+    *pending = next;
+    let stored = block.store_velocity_where(k - 2, finishing, finished);
+    Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
+}
+
+/// [`hand_on_lanes`] where every lane has nodes `k − 2 ≥ 2`, `k − 1` and `k`: no masks.
+#[inline(always)]
+fn hand_on_every_lane<const W: usize, const N: usize>(
     setup: &Setup,
     block: &mut DftlBlock<W, N>,
     k: usize,
-    finishing: WideMask<W>,
+    pending: &mut Pending<Wide<W>>,
     x_star: V3<Wide<W>>,
-    next_correction: V3<Wide<W>>,
+    (local, inextensible): (V3<Wide<W>>, V3<Wide<W>>),
 ) -> Wide<W> {
-    let Some(old_position) = block.state.get(k).map(|s| read_lanes(&s.position)) else {
-        return Wide::splat(0.0);
-    };
-    let (x_new, v_new) = velocity::finish(setup, x_star, old_position, next_correction);
-    let stored = block.store_node_where(k, finishing, x_new, v_new);
-    Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
+    let x = block
+        .state
+        .get(k - 1)
+        .map_or(x_star, |s| read_lanes(&s.position));
+    let (finished, next) = pending.hand_on(setup, x_star, x, local, inextensible);
+    let all = Wide::<W>::mask(true);
+    block.store_position_where(k - 1, all, x_star);
+    *pending = next;
+    component_sum(block.store_velocity_where(k - 2, all, finished))
 }
 
 /// Each lane's tally into the report, in lane order.
