@@ -203,3 +203,28 @@ fn head_3_keeps_its_groom_with_dftl() {
 fn the_curly_head_keeps_its_groom() {
     keeps_its_groom("curly-head");
 }
+
+/// The groom table's scenes (`scenes/groom/`, sample files through `HAIRSIM_SAMPLES`) pass
+/// `hairsim check` and run, and their summaries carry the groom.
+#[test]
+fn the_groom_tables_scenes_run() {
+    use hairsim::run::{load, run, HairFileOptions, RunOptions};
+    let folder = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/groom");
+    let mut count = 0;
+    for entry in std::fs::read_dir(folder).expect("scenes/groom") {
+        let path = entry.unwrap().path();
+        let spec = path.to_str().unwrap();
+        hairsim::cmd::check::check(spec, &HairFileOptions::default())
+            .unwrap_or_else(|e| panic!("{e:#}"));
+        let loaded = load(spec, &HairFileOptions::default()).unwrap();
+        let options = RunOptions {
+            steps: Some(20),
+            ..RunOptions::default()
+        };
+        let summary = run(&loaded, &options).unwrap();
+        assert!(summary.finite, "{spec}");
+        assert!(summary.groom.nodes > 1000, "{spec}: {:?}", summary.groom);
+        count += 1;
+    }
+    assert_eq!(count, 5);
+}

@@ -79,6 +79,9 @@ pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
 /// replays from any folder.
 fn with_absolute_hair_file(mut scene: Scene, base: &Path) -> Scene {
     if let Some(crate::scene::HairSpec::File(file)) = &mut scene.hair {
+        if file.path.starts_with(crate::scene::prepare::SAMPLES_PREFIX) {
+            return scene;
+        }
         let joined = base.join(&file.path);
         if let Ok(absolute) = std::path::absolute(&joined) {
             file.path = absolute.display().to_string();

@@ -615,17 +615,33 @@ fn output_plan(scene: &Scene) -> OutputPlan {
     }
 }
 
+/// A `hair.file.path` starting with this is read from the folder `HAIRSIM_SAMPLES` names:
+/// scenes of the sample hair files, which are not part of the repository.
+pub const SAMPLES_PREFIX: &str = "$HAIRSIM_SAMPLES/";
+
+/// The folder `HAIRSIM_SAMPLES` names.
+fn samples_folder() -> Result<std::path::PathBuf, FieldError> {
+    match std::env::var_os("HAIRSIM_SAMPLES") {
+        Some(folder) if !folder.is_empty() => Ok(folder.into()),
+        _ => Err(FieldError::new(
+            "hair.file.path",
+            format!("{SAMPLES_PREFIX}…: HAIRSIM_SAMPLES is not set; set it to the folder of the sample hair files"),
+        )),
+    }
+}
+
 /// Reads the strands of a `[hair.file]` (via the `hairfile` module), checked for what the
-/// simulator needs: 3 to 128 nodes per strand.
+/// simulator needs: 3 to 128 nodes per strand. A path starting with [`SAMPLES_PREFIX`] is
+/// read from the folder `HAIRSIM_SAMPLES` names.
 pub fn read_hair_file(
     file: &super::FileSpec,
     base: &Path,
 ) -> Result<crate::hairfile::HairModel, FieldError> {
     use crate::hairfile::{read_path, ReadOptions, UpAxis};
-    let path = if base == Path::new(".") {
-        Path::new(&file.path).to_path_buf()
-    } else {
-        base.join(&file.path)
+    let path = match file.path.strip_prefix(SAMPLES_PREFIX) {
+        Some(rest) => samples_folder()?.join(rest),
+        None if base == Path::new(".") => Path::new(&file.path).to_path_buf(),
+        None => base.join(&file.path),
     };
     let options = ReadOptions {
         scale: file.scale.unwrap_or(1.0),
