@@ -56,8 +56,6 @@ pub struct StateLanes<const W: usize> {
 pub struct RestLanes<const W: usize> {
     /// `l_k = |x̂_k − x̂_{k−1}|` (0 for `k = 0`).
     pub segment_length: Lanes<W>,
-    /// `1/m_k`.
-    pub inverse_mass: Lanes<W>,
     /// `1/(2 l_k²)` (0 for `k = 0`).
     pub strain_scale: Lanes<W>,
 }
@@ -133,7 +131,6 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
             }; N],
             rest: [RestLanes {
                 segment_length: [0.0; W],
-                inverse_mass: [0.0; W],
                 strain_scale: [0.0; W],
             }; N],
             shape: [ShapeLanes {
@@ -167,7 +164,6 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
                 } else {
                     0.0
                 };
-                rest.inverse_mass[l] = strand.rest.inverse_mass[k];
                 self.mass[k][l] = strand.rest.mass[k];
                 rest.strain_scale[l] = strand.rest.dftl.strain_scale[k];
                 let shape = &mut self.shape[k];
@@ -238,7 +234,6 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
             extra,
             has_extra,
             mass: Wide(*self.mass.get(k)?),
-            inverse_mass: Wide(rest.inverse_mass),
             rest_position: read_lanes(&shape.rest_position),
             local_rest: read_lanes(&shape.local_rest),
             root_distance: Wide(shape.root_distance),

@@ -129,10 +129,8 @@ pub struct NodeInput<T: Lane> {
     pub extra: V3<T>,
     /// Whether the caller gave an acceleration.
     pub has_extra: T::Mask,
-    /// `m_i` (weighs the collider's push).
+    /// `m_i` (drag, and weighs the collider's push).
     pub mass: T,
-    /// `1/m_i`.
-    pub inverse_mass: T,
     /// `x̂_i` (head frame).
     pub rest_position: V3<T>,
     /// `r_i`.
@@ -163,7 +161,6 @@ impl NodeInput<Real> {
             extra: extra.unwrap_or(Vec3::ZERO).into(),
             has_extra: extra.is_some(),
             mass: rest.mass[i],
-            inverse_mass: rest.inverse_mass[i],
             rest_position: rest.position[i].into(),
             local_rest: rest.dftl.local_rest[i].into(),
             root_distance: rest.dftl.root_distance[i],

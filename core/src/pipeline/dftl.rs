@@ -449,7 +449,7 @@ fn block_pass<
     for k in max_nodes..max_nodes + 2 {
         let zero = V3::zero();
         let (x_star, b) = (chain.position, &mut *block);
-        let (p, at) = (&mut pending, (k, nodes_real));
+        let (p, at) = (&mut pending, handing_lanes(k, nodes_real));
         let written = hand_on_lanes(&setup, b, at, p, x_star, (zero, zero));
         velocity_total = velocity_total + written;
     }
@@ -498,19 +498,13 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     let local = V3::select(active, next.local, V3::zero());
     let inextensible = V3::select(active, next.inextensible, V3::zero());
     let x_star = carried.chain.position;
-    let written = if ALL {
-        hand_on_every_lane(
-            setup,
-            block,
-            k,
-            carried.pending,
-            x_star,
-            (local, inextensible),
-        )
+    let at = if ALL {
+        (k, Wide::<W>::mask(true), Wide::<W>::mask(true))
     } else {
-        let (pending, at) = (&mut *carried.pending, (k, nodes_real));
-        hand_on_lanes(setup, block, at, pending, x_star, (local, inextensible))
+        handing_lanes(k, nodes_real)
     };
+    let pending = &mut *carried.pending;
+    let written = hand_on_lanes(setup, block, at, pending, x_star, (local, inextensible));
     *carried.velocity_total = *carried.velocity_total + written;
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
@@ -518,20 +512,19 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
 
 /// Lines 24–26 once node `k` of every lane is advanced (or, past a lane's end, with zero
 /// corrections), as the per-strand path's `hand_on`: node `k − 1`'s final position `x_star`
-/// is stored where it is free, and node `k − 2`'s velocity where it is free. Returns the
-/// [`component_sum`] of the velocities stored, 0 in the other lanes (whose velocities the
-/// last guard saw finite): each lane's total adds its strand's per-strand terms in the same
-/// order, and zeros, which change no verdict.
+/// is stored where `moving` (it is free), and node `k − 2`'s velocity where `finishing`.
+/// Returns the [`component_sum`] of the velocities stored, 0 in the other lanes (whose
+/// velocities the last guard saw finite): each lane's total adds its strand's per-strand terms
+/// in the same order, and zeros, which change no verdict. Constant masks fold away.
 #[inline(always)]
 fn hand_on_lanes<const W: usize, const N: usize>(
     setup: &Setup,
     block: &mut DftlBlock<W, N>,
-    (k, nodes_real): (usize, Wide<W>),
+    (k, moving, finishing): (usize, WideMask<W>, WideMask<W>),
     pending: &mut Pending<Wide<W>>,
     x_star: V3<Wide<W>>,
     (local, inextensible): (V3<Wide<W>>, V3<Wide<W>>),
 ) -> Wide<W> {
-    let (moving, finishing) = (free_lanes(k - 1, nodes_real), free_lanes(k - 2, nodes_real));
     let x = block
         .state
         .get(k - 1)
@@ -544,25 +537,18 @@ fn hand_on_lanes<const W: usize, const N: usize>(
     Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
 }
 
-/// [`hand_on_lanes`] where every lane has nodes `k − 2 ≥ 2`, `k − 1` and `k`: no masks.
+/// The masks of [`hand_on_lanes`] at node `k`: node `k − 1` free and in the lane, node
+/// `k − 2` likewise.
 #[inline(always)]
-fn hand_on_every_lane<const W: usize, const N: usize>(
-    setup: &Setup,
-    block: &mut DftlBlock<W, N>,
+fn handing_lanes<const W: usize>(
     k: usize,
-    pending: &mut Pending<Wide<W>>,
-    x_star: V3<Wide<W>>,
-    (local, inextensible): (V3<Wide<W>>, V3<Wide<W>>),
-) -> Wide<W> {
-    let x = block
-        .state
-        .get(k - 1)
-        .map_or(x_star, |s| read_lanes(&s.position));
-    let (finished, next) = pending.hand_on(setup, x_star, x, local, inextensible);
-    let all = Wide::<W>::mask(true);
-    block.store_position_where(k - 1, all, x_star);
-    *pending = next;
-    component_sum(block.store_velocity_where(k - 2, all, finished))
+    nodes_real: Wide<W>,
+) -> (usize, WideMask<W>, WideMask<W>) {
+    (
+        k,
+        free_lanes(k - 1, nodes_real),
+        free_lanes(k - 2, nodes_real),
+    )
 }
 
 /// Each lane's tally into the report, in lane order.

@@ -83,7 +83,6 @@ fn rest_frames_put_each_node_on_its_local_target() {
             extra: V3::zero(),
             has_extra: false,
             mass: s.rest.mass[i],
-            inverse_mass: s.rest.inverse_mass[i],
             rest_position: s.rest.position[i].into(),
             local_rest: s.rest.dftl.local_rest[i].into(),
             root_distance: s.rest.dftl.root_distance[i],
