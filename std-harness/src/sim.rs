@@ -25,42 +25,7 @@ use rayon::prelude::*;
 use crate::scene::{FieldError, Prepared};
 use crate::sph::Sph;
 
-/// The time-varying inputs of one step (what a recording stores).
-#[derive(Clone, Debug, PartialEq)]
-pub struct StepInputs {
-    /// The head's pose at the end of the step.
-    pub head: Pose,
-    /// Each grab's target.
-    pub grab_targets: Vec<Vec3>,
-    /// Each grab: whether it has been let go.
-    pub released: Vec<bool>,
-}
-
-/// Time at the end of step `k` (0-based): `(k + 1) · dt`, computed in `f32` exactly as the
-/// firmware computes it.
-#[must_use]
-pub fn time_after(k: u64, dt: Real) -> Real {
-    (k + 1) as Real * dt
-}
-
-/// The scene's inputs for step `k`.
-#[must_use]
-pub fn scene_inputs<M: Math>(prepared: &Prepared, k: u64) -> StepInputs {
-    let t = time_after(k, prepared.params.dt);
-    StepInputs {
-        head: prepared.motion.pose_at::<M>(t),
-        grab_targets: prepared
-            .grabs
-            .iter()
-            .map(|g| g.path.target_at::<M>(t))
-            .collect(),
-        released: prepared
-            .grabs
-            .iter()
-            .map(|g| g.path.released_at(t))
-            .collect(),
-    }
-}
+pub use crate::scene::start::{scene_inputs, time_after, StepInputs};
 
 /// Lanes of the DFTL blocks.
 const LANES: usize = RECOMMENDED_LANES;
@@ -138,22 +103,8 @@ impl<const N: usize, M: Math> Sim<N, M> {
         threads: usize,
         layout: Layout,
     ) -> Result<Self, FieldError> {
-        let head = prepared.motion.pose_at::<M>(0.0);
-        let mut strands = Vec::with_capacity(prepared.strands.len());
-        for (i, spec) in prepared.strands.iter().enumerate() {
-            let mut strand = Strand::<N>::from_polyline(&spec.points, &spec.material)
-                .map_err(|e| FieldError::new(spec.field.clone(), format!("strand {i}: {e}")))?;
-            fade_bending(&mut strand, spec.tip_stiffness);
-            if head != Pose::IDENTITY {
-                place(&mut strand, &head);
-            }
-            strands.push(strand);
-        }
-        let grabs = prepared
-            .grabs
-            .iter()
-            .map(|g| Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit))
-            .collect();
+        let (strands, head) = prepared.start_strands::<N, M>()?;
+        let grabs = prepared.start_grabs::<M>();
         // A pool even for one thread when SPH runs: its parallel passes would otherwise go to
         // rayon's global pool, with a thread per core.
         let pool = if threads > 1 || prepared.sph.is_some() {
@@ -417,31 +368,6 @@ fn load_state<const N: usize>(block: &mut DftlBlock<LANES, N>, strands: &[Strand
             }
         }
     }
-}
-
-/// Bending stiffness fading linearly from the root's to `tip` (≤ 1) times it at the last
-/// segment, in the rest data the rod's stages read (`rest.rod.bending_stiffness`), set once
-/// before the first step. Only ever lowered, so the rod's stable time step (computed from the
-/// root's, the stiffest) stays valid.
-fn fade_bending<const N: usize>(strand: &mut Strand<N>, tip: Real) {
-    if tip == 1.0 {
-        return;
-    }
-    let segments = strand.nodes() - 1;
-    for j in 0..segments {
-        let s = j as Real / (segments.max(2) - 1) as Real;
-        let factor = 1.0 - s + s * tip;
-        strand.rest.rod.bending_stiffness[j] *= factor;
-    }
-}
-
-/// Moves a strand built in the head's frame to the head's starting pose.
-fn place<const N: usize>(strand: &mut Strand<N>, head: &Pose) {
-    let n = strand.nodes();
-    for p in &mut strand.state.position[..n] {
-        *p = head.transform_point(*p);
-    }
-    strand.state.root_frame = head.transform_vector(strand.state.root_frame);
 }
 
 #[cfg(test)]

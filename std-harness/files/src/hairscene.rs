@@ -22,7 +22,7 @@ use std::path::Path;
 
 use hairsim_core::Vec3;
 
-use crate::scene::{ColliderSpec, FieldError, FileSpec, HairSpec, Scene, FORMAT};
+use crate::scene::{ColliderSpec, FieldError, FileSpec, HairFiles, HairSpec, Scene, FORMAT};
 
 /// Options for a hair file given as the scene (`hairsim run head.hair`).
 #[derive(Clone, Debug, Default)]
@@ -44,13 +44,22 @@ pub const HAIR_LENGTH: f32 = 0.25;
 
 /// The default scene for the hair file at `path`.
 pub fn scene_for_hair_file(path: &Path, options: &HairFileOptions) -> Result<Scene, FieldError> {
+    scene_for_hair_file_in(path, options, HairFiles::Disk(Path::new(".")))
+}
+
+/// The default scene for the hair file at `path`, read from `files`.
+pub fn scene_for_hair_file_in(
+    path: &Path,
+    options: &HairFileOptions,
+    files: HairFiles<'_>,
+) -> Result<Scene, FieldError> {
     // Checked like a scene's [hair.file] table, so --scale and --up get the same messages.
     let bare = scene_around(path, options, &[]);
     crate::scene::validate_only(&bare)?;
     let Some(HairSpec::File(file)) = &bare.hair else {
         return Ok(bare);
     };
-    let model = crate::scene::prepare::read_hair_file(file, Path::new("."))?;
+    let model = crate::scene::prepare::read_hair_file(file, files)?;
     let mut roots: Vec<Vec3> = model
         .strands
         .iter()

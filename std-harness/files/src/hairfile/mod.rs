@@ -227,32 +227,66 @@ impl HairModel {
 /// # Errors
 /// I/O errors, an unknown extension, or anything the readers refuse.
 pub fn read_path(path: &Path, options: &ReadOptions) -> Result<HairModel, HairFileError> {
-    let ext = path
+    let name = path.display().to_string();
+    // An unknown extension is refused before the file is opened.
+    reader_for(&name)?;
+    let bytes = std::fs::read(path).map_err(|e| HairFileError::Io {
+        path: name.clone(),
+        message: e.to_string(),
+    })?;
+    read_bytes(&name, &bytes, options)
+}
+
+/// The hair-file formats, by extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum FileFormat {
+    Hair,
+    Tfx,
+    Obj,
+    Ply,
+    Usda,
+}
+
+/// The format a file called `name` holds, by its extension.
+fn reader_for(name: &str) -> Result<FileFormat, HairFileError> {
+    let ext = Path::new(name)
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let io = |message: String| HairFileError::Io {
-        path: path.display().to_string(),
-        message,
-    };
+    match ext.as_deref() {
+        Some("hair") => Ok(FileFormat::Hair),
+        Some("tfx") => Ok(FileFormat::Tfx),
+        Some("obj") => Ok(FileFormat::Obj),
+        Some("ply") => Ok(FileFormat::Ply),
+        Some("usda") => Ok(FileFormat::Usda),
+        _ => Err(HairFileError::UnknownExtension(name.to_string())),
+    }
+}
+
+/// Reads a hair file held in memory (a file dropped on the viewer's page), choosing the reader
+/// by the extension of `name`, as [`read_path`] does.
+///
+/// # Errors
+/// An unknown extension, a text format that is not UTF-8, or anything the readers refuse.
+pub fn read_bytes(
+    name: &str,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<HairModel, HairFileError> {
     type TextReader = fn(&str) -> Result<Vec<Vec<Vec3>>, crate::export::TextReadError>;
-    let text_reader: TextReader = match ext.as_deref() {
-        Some("hair") => {
-            let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
-            return read_hair(&bytes, options);
-        }
-        Some("tfx") => {
-            let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
-            return read_tfx(&bytes, options);
-        }
-        Some("obj") => crate::export::read_obj,
-        Some("ply") => crate::export::read_ply,
-        Some("usda") => crate::export::read_usda,
-        _ => return Err(HairFileError::UnknownExtension(path.display().to_string())),
+    let text_reader: TextReader = match reader_for(name)? {
+        FileFormat::Hair => return read_hair(bytes, options),
+        FileFormat::Tfx => return read_tfx(bytes, options),
+        FileFormat::Obj => crate::export::read_obj,
+        FileFormat::Ply => crate::export::read_ply,
+        FileFormat::Usda => crate::export::read_usda,
     };
-    let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
-    let strands = text_reader(&text).map_err(|e| HairFileError::Text {
-        path: path.display().to_string(),
+    let text = std::str::from_utf8(bytes).map_err(|e| HairFileError::Io {
+        path: name.to_string(),
+        message: format!("not UTF-8 text: {e}"),
+    })?;
+    let strands = text_reader(text).map_err(|e| HairFileError::Text {
+        path: name.to_string(),
         message: e.to_string(),
     })?;
     HairModel::from_polylines(&strands, options)

@@ -14,6 +14,7 @@ pub mod generate;
 pub mod motion;
 pub mod prepare;
 mod spans;
+pub mod start;
 mod validate;
 
 use std::path::Path;
@@ -22,6 +23,21 @@ use serde::{Deserialize, Serialize};
 
 pub use error::{FieldError, SceneError};
 pub use prepare::Prepared;
+
+/// Where a scene's `[hair.file]` is read from.
+#[derive(Clone, Copy, Debug)]
+pub enum HairFiles<'a> {
+    /// The disk: relative paths from this folder.
+    Disk(&'a Path),
+    /// One file held in memory, called `name` (a file dropped on the viewer's page, which has
+    /// no disk): the scene's hair file is this one, whatever path the scene gives.
+    Memory {
+        /// The file's name (its extension picks the reader).
+        name: &'a str,
+        /// The file's bytes.
+        bytes: &'a [u8],
+    },
+}
 
 /// The only scene format this build reads.
 pub const FORMAT: u32 = 1;
@@ -579,8 +595,13 @@ impl Scene {
 
     /// As [`Scene::prepare`], relative hair-file paths taken from `base`.
     pub fn prepare_in(&self, base: &Path) -> Result<Prepared, FieldError> {
+        self.prepare_from(HairFiles::Disk(base))
+    }
+
+    /// As [`Scene::prepare`], the hair file read from `files`.
+    pub fn prepare_from(&self, files: HairFiles<'_>) -> Result<Prepared, FieldError> {
         validate::check(self)?;
-        prepare::prepare(self, base)
+        prepare::prepare(self, files)
     }
 
     /// The scene as scene-file text (what a recording stores).

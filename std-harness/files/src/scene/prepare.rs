@@ -16,8 +16,8 @@ use super::generate::{self, v3, Follower, Style};
 use super::motion::{GrabPath, Key, Motion, Path as TargetPath};
 use super::validate::{self, MAX_NODES};
 use super::{
-    ColliderSpec, DftlSpec, GrabSpec, HairSpec, MaterialSpec, MotionSpec, RodSpec, ScalpSpec,
-    Scene, StandSpec, StrandSpec, StyleSpec, WindSpec,
+    ColliderSpec, DftlSpec, GrabSpec, HairFiles, HairSpec, MaterialSpec, MotionSpec, RodSpec,
+    ScalpSpec, Scene, StandSpec, StrandSpec, StyleSpec, WindSpec,
 };
 use crate::sph::SphParams;
 
@@ -165,13 +165,13 @@ fn unit(d: [f32; 3]) -> Vec3 {
 /// The checks run in this order, so that the first error a scene gets never changes: the
 /// solver and effects, the hair (a hair file is read here), the strands' polylines, the grabs,
 /// the parameters, each strand against the time step, then the hair–hair parameters.
-pub fn prepare(scene: &Scene, base: &Path) -> Result<Prepared, FieldError> {
+pub fn prepare(scene: &Scene, files: HairFiles<'_>) -> Result<Prepared, FieldError> {
     let solver = validate::solver(scene)?;
     let effect_list = validate::effects(scene, solver)?;
     let effects = Effects::from_slice(&effect_list);
     let params = params(scene, solver, effects);
     let (base_material, base_tip) = material(&Material::HUMAN_HAIR, scene.material.as_ref());
-    let (mut strands, followers) = hair(scene, base, base_material, base_tip)?;
+    let (mut strands, followers) = hair(scene, files, base_material, base_tip)?;
     strands.extend(listed_strands(scene, &base_material, base_tip));
     check_polylines(&strands)?;
     let colliders = colliders(scene);
@@ -283,7 +283,7 @@ fn step_count(scene: &Scene) -> u64 {
 /// The `[hair]` section's strands (generated, or read from a hair file) and followers.
 fn hair(
     scene: &Scene,
-    base: &Path,
+    files: HairFiles<'_>,
     material: Material,
     tip_stiffness: Real,
 ) -> Result<(Vec<RestSpec>, Vec<Follower>), FieldError> {
@@ -310,7 +310,7 @@ fn hair(
             }
         }
         Some(HairSpec::File(file)) => {
-            for points in read_hair_file(file, base)?.strands {
+            for points in read_hair_file(file, files)?.strands {
                 strands.push(rest(points, "hair.file"));
             }
         }
@@ -630,19 +630,14 @@ fn samples_folder() -> Result<std::path::PathBuf, FieldError> {
     }
 }
 
-/// Reads the strands of a `[hair.file]` (via the `hairfile` module), checked for what the
-/// simulator needs: 3 to 128 nodes per strand. A path starting with [`SAMPLES_PREFIX`] is
-/// read from the folder `HAIRSIM_SAMPLES` names.
+/// Reads the strands of a `[hair.file]` (via the `hairfile` module) from `files`, checked for
+/// what the simulator needs: 3 to 128 nodes per strand. On disk, a path starting with
+/// [`SAMPLES_PREFIX`] is read from the folder `HAIRSIM_SAMPLES` names.
 pub fn read_hair_file(
     file: &super::FileSpec,
-    base: &Path,
+    files: HairFiles<'_>,
 ) -> Result<crate::hairfile::HairModel, FieldError> {
-    use crate::hairfile::{read_path, ReadOptions, UpAxis};
-    let path = match file.path.strip_prefix(SAMPLES_PREFIX) {
-        Some(rest) => samples_folder()?.join(rest),
-        None if base == Path::new(".") => Path::new(&file.path).to_path_buf(),
-        None => base.join(&file.path),
-    };
+    use crate::hairfile::{read_bytes, read_path, ReadOptions, UpAxis};
     let options = ReadOptions {
         scale: file.scale.unwrap_or(1.0),
         up_axis: if file.up.as_deref() == Some("z") {
@@ -654,20 +649,27 @@ pub fn read_hair_file(
         max_strands: file.max_strands.map(|n| n as usize),
         min_length: file.min_length.unwrap_or(0.001),
     };
-    let model = read_path(&path, &options).map_err(|e| {
-        FieldError::new(
-            "hair.file.path",
-            format!("cannot read \"{}\": {e}", path.display()),
-        )
-    })?;
+    let (path, model) = match files {
+        HairFiles::Disk(base) => {
+            let path = match file.path.strip_prefix(SAMPLES_PREFIX) {
+                Some(rest) => samples_folder()?.join(rest),
+                None if base == Path::new(".") => Path::new(&file.path).to_path_buf(),
+                None => base.join(&file.path),
+            };
+            let model = read_path(&path, &options);
+            (path.display().to_string(), model)
+        }
+        HairFiles::Memory { name, bytes } => (name.to_string(), read_bytes(name, bytes, &options)),
+    };
+    let model = model
+        .map_err(|e| FieldError::new("hair.file.path", format!("cannot read \"{path}\": {e}")))?;
     let longest = model.strands.iter().map(Vec::len).max().unwrap_or(0);
     let shortest = model.strands.iter().map(Vec::len).min().unwrap_or(0);
     if model.strands.is_empty() {
         return Err(FieldError::new(
             "hair.file.path",
             format!(
-                "\"{}\" holds no strand longer than min_length, allowed: a file with strands",
-                path.display()
+                "\"{path}\" holds no strand longer than min_length, allowed: a file with strands"
             ),
         ));
     }

@@ -1,0 +1,384 @@
+//! What the page runs: a scene loaded from a built-in name, a scene file or a hair file (the
+//! harness's own readers and checks), stepped at the scene's `dt`, with the solver, the
+//! effects and the twist method switched from the page's panel.
+//!
+//! A switch goes through the scene, never around it: the page edits the scene as a user would
+//! edit its file, and the scene's checks (`Scene::prepare_from`) accept or refuse it with
+//! their own message. An effect or the twist method changes the parameters of the running
+//! strands; the solver restarts the scene (the two models keep different rest data).
+
+use std::path::Path;
+
+use hairsim_core::{DefaultMath, Effect, GrabStatus, Real, Shape, Solver, Vec3};
+use hairsim_files::builtin;
+use hairsim_files::hairscene::{scene_for_hair_file_in, HairFileOptions};
+use hairsim_files::scene::start::scene_inputs;
+use hairsim_files::scene::{locate, FieldError, HairFiles, Prepared, RodSpec, Scene};
+use serde_json::{json, Value};
+
+use crate::stepper::Stepper;
+
+/// Largest force the hand's grab transmits before it slips, N: far above what a strand's
+/// weight and stiffness put on it, so it slips only when the pointer leaves the strand's reach.
+pub const HAND_FORCE_LIMIT: Real = 1.0;
+
+/// Where the scene came from.
+#[derive(Clone, Debug)]
+pub enum Source {
+    /// A built-in scene, by name.
+    Builtin(&'static str),
+    /// A hair file (`.hair`, `.tfx`, `.obj`, `.ply`, `.usda`) in its default scene.
+    HairFile {
+        /// The file's name.
+        name: String,
+        /// Its bytes.
+        bytes: Vec<u8>,
+    },
+    /// A scene file and, if it reads one, its hair file.
+    SceneFile {
+        /// The scene file's name.
+        name: String,
+        /// Its text.
+        text: String,
+        /// The hair file its `[hair.file]` reads, by name and bytes.
+        hair: Option<(String, Vec<u8>)>,
+    },
+}
+
+impl Source {
+    /// A built-in scene called `name`.
+    ///
+    /// # Errors
+    /// No built-in scene has that name.
+    pub fn builtin(name: &str) -> Result<Source, String> {
+        builtin::find(name)
+            .map(|b| Source::Builtin(b.name))
+            .ok_or_else(|| {
+                let names: Vec<&str> = builtin::BUILTINS.iter().map(|b| b.name).collect();
+                format!("{name}: not a built-in scene ({})", names.join(", "))
+            })
+    }
+
+    fn label(&self) -> String {
+        match self {
+            Source::Builtin(name) => format!("builtin:{name}"),
+            Source::HairFile { name, .. } | Source::SceneFile { name, .. } => name.clone(),
+        }
+    }
+
+    /// Where the scene's hair file is read from.
+    fn files(&self) -> HairFiles<'_> {
+        match self {
+            Source::HairFile { name, bytes }
+            | Source::SceneFile {
+                hair: Some((name, bytes)),
+                ..
+            } => HairFiles::Memory { name, bytes },
+            _ => HairFiles::Disk(Path::new(".")),
+        }
+    }
+
+    /// The scene as loaded, before the page changes anything.
+    fn scene(&self) -> Result<Scene, String> {
+        match self {
+            Source::Builtin(name) => Ok(builtin::find(name)
+                .map(|b| (b.scene)())
+                .ok_or_else(|| format!("{name}: not a built-in scene"))?),
+            Source::HairFile { name, .. } => {
+                let path = Path::new(name);
+                scene_for_hair_file_in(path, &HairFileOptions::default(), self.files())
+                    .map_err(|e| format!("{name} (default scene): {e}"))
+            }
+            Source::SceneFile { name, text, .. } => {
+                Scene::from_toml(text, name).map_err(|e| e.to_string())
+            }
+        }
+    }
+
+    /// `error` from preparing this source's scene, placed as the harness places it.
+    fn error(&self, error: &FieldError) -> String {
+        match self {
+            Source::Builtin(name) => error.in_builtin(name).to_string(),
+            Source::HairFile { name, .. } => format!("{name} (default scene): {error}"),
+            Source::SceneFile { name, text, .. } => locate(error, name, text).to_string(),
+        }
+    }
+}
+
+/// The running strands at the capacity the scene needs (the harness's rule: 32 nodes, else
+/// 128).
+#[derive(Debug)]
+enum Running {
+    Small(Box<Stepper<32>>),
+    Large(Box<Stepper<128>>),
+}
+
+/// Runs `$body` with `$s` bound to the stepper, whatever its capacity.
+macro_rules! each {
+    ($running:expr, $s:ident => $body:expr) => {
+        match $running {
+            Running::Small($s) => $body,
+            Running::Large($s) => $body,
+        }
+    };
+}
+
+impl Running {
+    fn new(prepared: &Prepared) -> Result<Running, FieldError> {
+        Ok(if prepared.max_nodes() <= 32 {
+            Running::Small(Box::new(Stepper::new(prepared)?))
+        } else {
+            Running::Large(Box::new(Stepper::new(prepared)?))
+        })
+    }
+}
+
+/// A loaded scene, running.
+#[derive(Debug)]
+pub struct Session {
+    source: Source,
+    /// The scene as the page has edited it.
+    scene: Scene,
+    prepared: Prepared,
+    running: Running,
+    /// Whether the scene asked for hair–hair interaction, which the page does not simulate.
+    hair_hair_dropped: bool,
+}
+
+impl Session {
+    /// Loads `source` and places its strands at the start.
+    ///
+    /// # Errors
+    /// The scene's or the hair file's error, as `hairsim run` words it.
+    pub fn load(source: Source) -> Result<Session, String> {
+        let mut scene = source.scene()?;
+        let hair_hair = Effect::HairHair.name();
+        let hair_hair_dropped = scene.effects.iter().any(|e| e == hair_hair);
+        scene.effects.retain(|e| e != hair_hair);
+        scene.hair_hair = None;
+        let prepared = scene
+            .prepare_from(source.files())
+            .map_err(|e| source.error(&e))?;
+        let running = Running::new(&prepared).map_err(|e| source.error(&e))?;
+        Ok(Session {
+            source,
+            scene,
+            prepared,
+            running,
+            hair_hair_dropped,
+        })
+    }
+
+    /// Back to the start, with the page's changes kept.
+    ///
+    /// # Errors
+    /// A strand the core refuses (it accepted them at load).
+    pub fn reset(&mut self) -> Result<(), String> {
+        self.running = Running::new(&self.prepared).map_err(|e| self.source.error(&e))?;
+        Ok(())
+    }
+
+    /// Advances `steps` steps with the scene's head motion and grab paths.
+    pub fn step(&mut self, steps: u32) {
+        for _ in 0..steps {
+            each!(&mut self.running, s => {
+                let inputs = scene_inputs::<DefaultMath>(&self.prepared, s.steps);
+                s.step(&inputs);
+            });
+        }
+    }
+
+    /// Steps taken since the start.
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        each!(&self.running, s => s.steps)
+    }
+
+    /// The state hash (what `hairsim run --json` prints as `state_hash`).
+    #[must_use]
+    pub fn state_hash(&self) -> u64 {
+        each!(&self.running, s => s.state_hash())
+    }
+
+    /// Every node's position into `out` and each strand's first node into `offsets`.
+    pub fn positions(&self, out: &mut Vec<f32>, offsets: &mut Vec<u32>) {
+        each!(&self.running, s => s.positions(out, offsets));
+    }
+
+    /// The scene edited by `edit`, checked; on success the new plan, the scene kept.
+    fn edited(&mut self, edit: impl FnOnce(&mut Scene)) -> Result<(), String> {
+        let mut scene = self.scene.clone();
+        edit(&mut scene);
+        let prepared = scene
+            .prepare_from(self.source.files())
+            .map_err(|e| self.source.error(&e))?;
+        self.scene = scene;
+        self.prepared = prepared;
+        Ok(())
+    }
+
+    /// Switches the solver and restarts: the rod trades `shape` for `bending` and `twist`,
+    /// DFTL the other way round (and lets go of grabs, which it has not).
+    ///
+    /// # Errors
+    /// The scene's checks refuse the switch (the running scene is kept).
+    pub fn set_solver(&mut self, solver: Solver) -> Result<(), String> {
+        let (name, add, remove): (&str, &[Effect], &[Effect]) = match solver {
+            Solver::Rod => ("rod", &[Effect::Bending, Effect::Twist], &[Effect::Shape]),
+            Solver::Dftl => (
+                "dftl",
+                &[Effect::Shape],
+                &[Effect::Bending, Effect::Twist, Effect::Grabs],
+            ),
+        };
+        self.edited(|scene| {
+            scene.solver = name.into();
+            scene
+                .effects
+                .retain(|e| !remove.iter().any(|r| r.name() == e));
+            for effect in add {
+                if !scene.effects.iter().any(|e| e == effect.name()) {
+                    scene.effects.push(effect.name().into());
+                }
+            }
+            if solver == Solver::Dftl {
+                scene.grabs.clear();
+            }
+        })?;
+        self.reset()
+    }
+
+    /// Turns `effect` on or off in the running scene.
+    ///
+    /// # Errors
+    /// The scene's checks refuse it (hair–hair always: the page has no SPH).
+    pub fn set_effect(&mut self, effect: Effect, on: bool) -> Result<(), String> {
+        if effect == Effect::HairHair {
+            return Err("hair-hair (SPH) runs in `hairsim run`, not in the page".into());
+        }
+        self.edited(|scene| {
+            scene.effects.retain(|e| e != effect.name());
+            if on {
+                scene.effects.push(effect.name().into());
+            }
+        })?;
+        if !on && effect == Effect::Grabs {
+            self.release();
+        }
+        self.apply_params()
+    }
+
+    /// Switches the rod's twist method (`hair-optimised` or `newton`) in the running scene.
+    ///
+    /// # Errors
+    /// The scene's checks refuse the name.
+    pub fn set_twist(&mut self, method: &str) -> Result<(), String> {
+        self.edited(|scene| {
+            scene.rod.get_or_insert_with(RodSpec::default).twist = Some(method.into());
+        })?;
+        self.apply_params()
+    }
+
+    /// The scene's parameters to the running strands, with `grabs` on while the hand holds
+    /// one (a scene file may not turn `grabs` on without a grab of its own; the hand's is not
+    /// the scene's).
+    fn apply_params(&mut self) -> Result<(), String> {
+        let mut params = self.prepared.params;
+        if each!(&self.running, s => s.hand().is_some()) {
+            params.effects = params.effects.with(Effect::Grabs);
+            params.validate().map_err(|e| e.to_string())?;
+        }
+        each!(&mut self.running, s => s.set_params(params));
+        Ok(())
+    }
+
+    /// Grabs `node` of `strand` where it is (turning `grabs` on).
+    ///
+    /// # Errors
+    /// DFTL (it has no grab constraint), or a grab the core cannot hold.
+    pub fn grab(&mut self, strand: usize, node: usize) -> Result<(), String> {
+        if self.prepared.params.solver == Solver::Dftl {
+            return Err("DFTL has no grab constraint: switch to the rod to grab a strand".into());
+        }
+        each!(&mut self.running, s => s.grab(strand, node, HAND_FORCE_LIMIT))?;
+        self.apply_params()
+    }
+
+    /// Moves the hand's target.
+    pub fn move_hand(&mut self, target: Vec3) {
+        each!(&mut self.running, s => s.move_hand(target));
+    }
+
+    /// Lets go of the hand's grab (and turns `grabs` off again unless the scene has it).
+    pub fn release(&mut self) {
+        each!(&mut self.running, s => s.release());
+        let params = self.prepared.params;
+        each!(&mut self.running, s => s.set_params(params));
+    }
+
+    /// What the page shows and the scene's fixed facts, as JSON.
+    #[must_use]
+    pub fn status(&self) -> Value {
+        let params = &self.prepared.params;
+        let (hand, colliders, report) = each!(&self.running, s => (
+            s.hand(),
+            s.colliders_now().map(shape_json).collect::<Vec<_>>(),
+            json!({
+                "contacts": s.report.contacts,
+                "rolled_back": s.report.rolled_back,
+                "max_stretch": s.report.max_stretch,
+            }),
+        ));
+        let (grab, force, target) = match hand {
+            Some((hand, status, force)) => (
+                match status {
+                    GrabStatus::Held => "held",
+                    GrabStatus::Slipped => "slipped",
+                    GrabStatus::Released => "released",
+                },
+                force,
+                Some(hand.target.to_array()),
+            ),
+            None => ("none", Vec3::ZERO, None),
+        };
+        json!({
+            "source": self.source.label(),
+            "scene": self.prepared.name,
+            "steps": self.steps(),
+            "time": self.steps() as f64 * f64::from(params.dt),
+            "dt": params.dt,
+            "state_hash": format!("{:#018x}", self.state_hash()),
+            "solver": match params.solver { Solver::Rod => "rod", Solver::Dftl => "dftl" },
+            "effects": params.effects.iter().map(Effect::name).collect::<Vec<_>>(),
+            "supported": Effect::ALL
+                .into_iter()
+                .filter(|e| *e != Effect::HairHair && params.solver.supports(*e))
+                .map(Effect::name)
+                .collect::<Vec<_>>(),
+            "hair_hair_dropped": self.hair_hair_dropped,
+            "twist": params.rod.twist.name(),
+            "grab": grab,
+            "grab_force": force.to_array(),
+            "grab_target": target,
+            "report": report,
+            "colliders": colliders,
+            "strands": self.prepared.strands.len(),
+            "nodes": self.prepared.nodes(),
+        })
+    }
+}
+
+/// A collider for the page to draw.
+fn shape_json(shape: Shape) -> Value {
+    match shape {
+        Shape::Sphere { centre, radius } => {
+            json!({"sphere": {"centre": centre.to_array(), "radius": radius}})
+        }
+        Shape::Capsule { a, b, radius } => {
+            json!({"capsule": {"a": a.to_array(), "b": b.to_array(), "radius": radius}})
+        }
+        Shape::Plane { point, normal } => {
+            json!({"plane": {"point": point.to_array(), "normal": normal.to_array()}})
+        }
+    }
+}

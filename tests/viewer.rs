@@ -1,0 +1,132 @@
+//! The viewer's simulation (what `hairsim view`'s page runs, here on the host) gives the bits
+//! of `hairsim run`: the same scenes, hair files read from bytes as from disk, and the page's
+//! switches and grabs going through the scene's checks.
+
+use std::path::PathBuf;
+
+use hairsim::run::{load, run, HairFileOptions, RunOptions};
+use hairsim_core::{Effect, Solver, Vec3};
+use hairsim_viewer::session::{Session, Source};
+
+/// `hairsim run SCENE --steps N`'s state hash.
+fn native_hash(scene: &str, steps: u64) -> String {
+    let loaded = load(scene, &HairFileOptions::default()).unwrap();
+    let options = RunOptions {
+        steps: Some(steps),
+        threads: 2,
+        ..RunOptions::default()
+    };
+    run(&loaded, &options).unwrap().state_hash
+}
+
+fn viewer_hash(source: Source, steps: u32) -> String {
+    let mut session = Session::load(source).unwrap();
+    // In uneven batches, as the page steps: the bits never depend on them.
+    let mut done = 0;
+    for batch in [1, 16, 17].into_iter().cycle() {
+        let n = batch.min(steps - done);
+        session.step(n);
+        done += n;
+        if done == steps {
+            break;
+        }
+    }
+    session.status()["state_hash"].as_str().unwrap().to_string()
+}
+
+#[test]
+fn builtin_scenes_give_the_bits_of_hairsim_run() {
+    for (scene, steps) in [("firmware", 400), ("firmware-dftl", 400), ("head-2", 60)] {
+        let page = viewer_hash(Source::builtin(scene).unwrap(), steps);
+        assert_eq!(page, native_hash(scene, u64::from(steps)), "{scene}");
+    }
+}
+
+#[test]
+fn a_hair_file_from_bytes_gives_the_bits_of_hairsim_run_on_the_path() {
+    let samples = std::env::var_os("HAIRSIM_SAMPLES")
+        .map(PathBuf::from)
+        .expect("HAIRSIM_SAMPLES names the folder of the sample hair files");
+    let path = samples.join("sintel_hair.tfx");
+    let bytes = std::fs::read(&path).unwrap();
+    let source = Source::HairFile {
+        name: "sintel_hair.tfx".into(),
+        bytes,
+    };
+    let page = viewer_hash(source, 30);
+    assert_eq!(page, native_hash(path.to_str().unwrap(), 30));
+}
+
+#[test]
+fn a_forged_hair_file_is_refused_with_the_readers_message() {
+    let source = Source::HairFile {
+        name: "forged.tfx".into(),
+        bytes: vec![7; 40],
+    };
+    let error = Session::load(source).unwrap_err();
+    assert!(error.contains("forged.tfx"), "{error}");
+}
+
+#[test]
+fn switches_go_through_the_scenes_checks() {
+    let mut session = Session::load(Source::builtin("firmware").unwrap()).unwrap();
+    session.step(10);
+    // The rod cannot preserve shape: refused, the running scene kept.
+    assert!(session.set_effect(Effect::Shape, true).is_err());
+    assert_eq!(session.steps(), 10);
+    session.set_effect(Effect::Wind, false).unwrap();
+    session.set_twist("newton").unwrap();
+    assert_eq!(session.status()["twist"], "newton");
+    session.set_solver(Solver::Dftl).unwrap();
+    assert_eq!(session.steps(), 0);
+    assert_eq!(session.status()["solver"], "dftl");
+    assert!(session.grab(0, 5).is_err(), "DFTL has no grab");
+}
+
+#[test]
+fn the_hand_pulls_the_hair_toward_its_target_harder_the_further_it_drags() {
+    // A scene file as the page gets it (by text): one 30 cm hair, let hang for 3 s.
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/one-hair.toml");
+    let source = Source::SceneFile {
+        name: "one-hair.toml".into(),
+        text: std::fs::read_to_string(path).unwrap(),
+        hair: None,
+    };
+    let mut session = Session::load(source).unwrap();
+    session.step(3000);
+    let mut positions = Vec::new();
+    let mut offsets = Vec::new();
+    session.positions(&mut positions, &mut offsets);
+    // A middle node, dragged sideways and up: toward the root's height, so the target
+    // stays within the strand's reach (a target out of reach lets go).
+    let node = (offsets[1] - offsets[0]) as usize / 2;
+    let at = 3 * (offsets[0] as usize + node);
+    let start = Vec3::new(positions[at], positions[at + 1], positions[at + 2]);
+    session.grab(0, node).unwrap();
+    let direction = Vec3::new(1.0, 1.0, 0.0).normalize();
+    let mut magnitudes = Vec::new();
+    for k in 1..=4 {
+        let target = start + direction * (0.01 * k as f32);
+        session.move_hand(target);
+        session.step(1000);
+        // The mean over 0.5 s: the hanging part still swings a little.
+        let mut sum = Vec3::ZERO;
+        for _ in 0..500 {
+            session.step(1);
+            let status = session.status();
+            assert_eq!(status["grab"], "held", "drag {k}");
+            let f = &status["grab_force"];
+            let component = |i: usize| f[i].as_f64().unwrap() as f32;
+            sum += Vec3::new(component(0), component(1), component(2));
+        }
+        let force = sum / 500.0;
+        eprintln!("drag {k}: {force}");
+        assert!(force.dot(direction) > 0.0, "drag {k}: {force}");
+        magnitudes.push(force.length());
+    }
+    assert!(magnitudes.windows(2).all(|w| w[1] > w[0]), "{magnitudes:?}");
+    session.release();
+    session.step(1);
+    assert_eq!(session.status()["grab"], "none");
+    assert_eq!(session.status()["grab_force"][0], 0.0);
+}
