@@ -23,5 +23,6 @@ pub mod sim;
 pub mod sph;
 pub mod study;
 pub mod summary;
+pub mod view;
 
 pub use hairsim_core as core;

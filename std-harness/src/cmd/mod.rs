@@ -5,6 +5,7 @@ pub mod replay;
 pub mod run;
 pub mod scenes;
 pub mod study;
+pub mod view;
 
 use std::path::PathBuf;
 
@@ -123,6 +124,19 @@ pub enum Command {
         #[arg(long, value_name = "B")]
         budget_us: Option<f64>,
     },
+    /// Serve the live viewer: the scene runs in the browser (the core in WebAssembly) in real
+    /// time, the mouse grabs a strand and feels its force. Prints the page's address.
+    #[command(
+        after_help = "Examples:\n  hairsim view\n  hairsim view head-2 --port 8080\n  hairsim view scenes/one-hair.toml\n  hairsim view strands.hair"
+    )]
+    View {
+        /// A built-in scene name, a TOML scene file, or a .hair/.tfx hair file (in a default
+        /// scene); the built-in default scene when omitted.
+        scene: Option<String>,
+        /// Port on 127.0.0.1; 0 picks a free one.
+        #[arg(long, default_value_t = 8000)]
+        port: u16,
+    },
 }
 
 /// The machine's cores (1 if it cannot tell).
@@ -187,5 +201,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<String> {
             knobs,
             budget_us,
         }),
+        Command::View { scene, port } => view::view(scene.as_deref(), port),
     }
 }

@@ -3,7 +3,7 @@
 //! the generated strands (grab nodes, degenerate polylines) happen here.
 
 #![deny(clippy::too_many_lines, clippy::too_many_arguments)]
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use hairsim_core::params::{DftlParams, RodParams, TwistMethod, WindParams};
 use hairsim_core::{
@@ -630,6 +630,19 @@ fn samples_folder() -> Result<std::path::PathBuf, FieldError> {
     }
 }
 
+/// Where on disk a `[hair.file]` of a scene file in folder `base` is: a path starting with
+/// [`SAMPLES_PREFIX`] in the folder `HAIRSIM_SAMPLES` names, any other relative to `base`.
+///
+/// # Errors
+/// The path starts with [`SAMPLES_PREFIX`] and `HAIRSIM_SAMPLES` is not set.
+pub fn hair_file_path(file: &super::FileSpec, base: &Path) -> Result<PathBuf, FieldError> {
+    Ok(match file.path.strip_prefix(SAMPLES_PREFIX) {
+        Some(rest) => samples_folder()?.join(rest),
+        None if base == Path::new(".") => Path::new(&file.path).to_path_buf(),
+        None => base.join(&file.path),
+    })
+}
+
 /// Reads the strands of a `[hair.file]` (via the `hairfile` module) from `files`, checked for
 /// what the simulator needs: 3 to 128 nodes per strand. On disk, a path starting with
 /// [`SAMPLES_PREFIX`] is read from the folder `HAIRSIM_SAMPLES` names.
@@ -651,11 +664,7 @@ pub fn read_hair_file(
     };
     let (path, model) = match files {
         HairFiles::Disk(base) => {
-            let path = match file.path.strip_prefix(SAMPLES_PREFIX) {
-                Some(rest) => samples_folder()?.join(rest),
-                None if base == Path::new(".") => Path::new(&file.path).to_path_buf(),
-                None => base.join(&file.path),
-            };
+            let path = hair_file_path(file, base)?;
             let model = read_path(&path, &options);
             (path.display().to_string(), model)
         }
