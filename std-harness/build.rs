@@ -2,9 +2,10 @@
 //! `wasm32-unknown-unknown` so that `hairsim view` can embed the module it serves.
 //!
 //! The module is built by a second cargo in its own target folder, `target/viewer-wasm` (or
-//! `$CARGO_TARGET_DIR/viewer-wasm`, the folder `.ci/run` builds it in too): a cargo inside a build script that shared the outer
-//! build's folder would wait forever on the outer build's lock. The module is rebuilt from
-//! source whenever the core, the file readers or the viewer change, so it never goes stale.
+//! `$CARGO_TARGET_DIR/viewer-wasm`, where `.ci/run` checks it): a cargo inside a build script
+//! that shared the outer build's folder would wait forever on the outer build's lock. The
+//! module is rebuilt from source whenever the core, the file readers or the viewer change, so
+//! it never goes stale.
 //! Without the wasm target the harness still builds; `hairsim view` then says how to get it.
 
 use std::env;
