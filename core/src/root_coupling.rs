@@ -9,7 +9,7 @@
 //! ([`Roots`]). The rod also carries its root frame with the head ([`carry_root_frame`]).
 
 use crate::context::StepContext;
-use crate::frames::{angle_in_frame, rest_root_frame, transport_in_time, unwrap_near};
+use crate::frames::{rest_root_frame, transport_in_time, unwrap_near};
 use crate::lane::{component_sum, Lane, Q, V3};
 use crate::math::{Math, Vec3};
 use crate::report::{Stage, StepReport};
@@ -122,12 +122,20 @@ pub fn carry_root_frame<M: Math, const N: usize>(
 ) {
     let state = &mut strand.state;
     let tangent = crate::math::unit::<M>(state.position[1] - state.position[0]);
-    let u = transport_in_time::<M>(old_tangent, tangent, state.root_frame);
+    // A root that did not turn keeps its frame bit for bit: the transport is the identity,
+    // and rounding it (`t·t` is not always 1 in f32) would turn θ^0 by an ulp every step.
+    let u = if tangent == old_tangent {
+        state.root_frame
+    } else {
+        transport_in_time::<M>(old_tangent, tangent, state.root_frame)
+    };
     let rest = &strand.rest;
     let rest_material =
         rest_root_frame::<M>(rest.position[0], rest.position[1], rest.segment_length[0]);
     let material = ctx.head.transform_vector(rest_material);
-    let angle = angle_in_frame::<M>(u, tangent.cross(u), material);
+    // `angle_in_frame(u, t × u, material)` with the triple product as `t·(u × material)`:
+    // the same angle, and exactly 0 when the material vector is `u` (the rest state).
+    let angle = M::atan2(tangent.dot(u.cross(material)), u.dot(material));
     state.theta[0] = unwrap_near(angle, state.theta[0]);
     state.root_frame = u;
 }

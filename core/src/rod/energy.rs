@@ -238,7 +238,6 @@ pub fn elastic_forces_with_angles<P: Precision, const N: usize>(
         *f = zero;
     }
     let two = P::R::of(2.0);
-    let half = P::R::of(0.5);
     // Holonomy weight suffix sum W_k = Σ_{j ≥ k} w_j, built from the tip.
     let mut suffix = P::R::ZERO;
     // ∂E_bend/∂θ^j from node j + 1 (frame j), carried down from the previous (k + 1) node.
@@ -258,18 +257,16 @@ pub fn elastic_forces_with_angles<P: Precision, const N: usize>(
         suffix += w;
         // Curvature binormal gradient: ∂E/∂x from (κb)_k.
         let kb = frames.curvature_binormal[k];
-        let inv_d = P::R::ONE / frames.denominator[k];
+        let inv_d = frames.inverse_denominator[k];
         let e_prev = frames.edge[k - 1];
         let e_next = frames.edge[k];
         let kb_dot = kb.dot(kb_gradient);
         let a = (kb_gradient.cross(e_next) * two + e_next * kb_dot) * inv_d;
         let c = (kb_gradient.cross(e_prev) * two - e_prev * kb_dot) * inv_d;
-        // Holonomy gradient of ψ_k, exact form.
-        let t_prev = frames.tangent[k - 1];
-        let t_next = frames.tangent[k];
-        let kb_unit = t_prev.cross(t_next) * (two / (P::R::ONE + t_prev.dot(t_next)));
-        let psi_prev = kb_unit * (half * frames.inverse_length[k - 1]);
-        let psi_next = -(kb_unit * (half * frames.inverse_length[k]));
+        // Holonomy gradient of ψ_k, exact form: ±κ̃b_k / (2|e|), κ̃b_k from the frame pass.
+        let half_holonomy = kb * frames.holonomy_scale[k];
+        let psi_prev = half_holonomy * frames.inverse_length[k - 1];
+        let psi_next = -(half_holonomy * frames.inverse_length[k]);
         forces[k - 1] += psi_prev * suffix - a;
         forces[k + 1] += psi_next * suffix - c;
         forces[k] += a + c - (psi_prev + psi_next) * suffix;

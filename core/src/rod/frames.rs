@@ -6,7 +6,7 @@
 //!
 //! Generic over a [`Precision`] so that the finite-difference tests run in `f64`.
 
-use crate::frames::{curvature_binormal, parallel_transport};
+use crate::frames::transport_perpendicular;
 use crate::math::Math;
 use crate::precision::{Precision, Scalar, Vector};
 use crate::strand::Strand;
@@ -48,6 +48,13 @@ pub struct RodFrames<P: Precision, const N: usize> {
     pub curvature_binormal: [P::V; N],
     /// `d_i = |ê^{i−1}||ê^i| + e^{i−1}·e^i`, the binormal's denominator.
     pub denominator: [P::R; N],
+    /// `1 / d_i`: the gradients multiply by it.
+    pub inverse_denominator: [P::R; N],
+    /// `½ κ̃b_i = ½ · 2 t^{i−1}×t^i / (1 + t^{i−1}·t^i)`, the holonomy's binormal (the
+    /// curvature binormal with the current lengths), as the factor `κ̃b_i / (2 (κb)_i) =
+    /// d_i / (|e^{i−1}||e^i| (1 + t^{i−1}·t^i))` on `(κb)_i`: the frame pass has every part of
+    /// it, where the force pass would rebuild the cross product and divide again.
+    pub holonomy_scale: [P::R; N],
     /// Bishop `u^j`.
     pub bishop_u: [P::V; N],
     /// Bishop `v^j = t^j × u^j`.
@@ -80,6 +87,8 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
             tangent: [zero; N],
             curvature_binormal: [zero; N],
             denominator: [P::R::ONE; N],
+            inverse_denominator: [P::R::ONE; N],
+            holonomy_scale: [P::R::ZERO; N],
             bishop_u: [zero; N],
             bishop_v: [zero; N],
             bishop_curvature: [[[P::R::ZERO; 2]; 2]; N],
@@ -102,28 +111,37 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
             let length = P::sqrt(e.dot(e));
             let inverse_length = P::R::ONE / length;
             let t = e * inverse_length;
-            let u = if j == 0 {
-                root_frame
-            } else {
-                parallel_transport::<P>(f.tangent[j - 1], t, f.bishop_u[j - 1])
-            };
             f.edge[j] = e;
             f.length[j] = length;
             f.inverse_length[j] = inverse_length;
             f.tangent[j] = t;
-            f.bishop_u[j] = u;
-            f.bishop_v[j] = t.cross(u);
-            if j > 0 {
-                let i = j;
-                let (kb, d) =
-                    curvature_binormal::<P>(f.edge[i - 1], e, rest_length[i - 1], rest_length[i]);
-                f.curvature_binormal[i] = kb;
-                f.denominator[i] = d;
-                f.bishop_curvature[i] = [
-                    [kb.dot(f.bishop_v[i - 1]), -kb.dot(f.bishop_u[i - 1])],
-                    [kb.dot(f.bishop_v[i]), -kb.dot(f.bishop_u[i])],
-                ];
+            if j == 0 {
+                f.bishop_u[0] = root_frame;
+                f.bishop_v[0] = t.cross(root_frame);
+                continue;
             }
+            let i = j;
+            let (e_prev, t_prev) = (f.edge[i - 1], f.tangent[i - 1]);
+            // One reciprocal of `1 + t^{i−1}·t^i` serves the transport and the holonomy.
+            let inverse_one_plus_cos = P::R::ONE / (P::R::ONE + t_prev.dot(t));
+            let u =
+                transport_perpendicular::<P>(t_prev, t, f.bishop_u[i - 1], inverse_one_plus_cos);
+            let v = t.cross(u);
+            f.bishop_u[i] = u;
+            f.bishop_v[i] = v;
+            // (κb)_i = 2 e^{i−1}×e^i / d_i with the rest lengths in d_i (BWR08 eq. 1).
+            let d = rest_length[i - 1] * rest_length[i] + e_prev.dot(e);
+            let inverse_d = P::R::ONE / d;
+            let kb = e_prev.cross(e) * (P::R::of(2.0) * inverse_d);
+            f.curvature_binormal[i] = kb;
+            f.denominator[i] = d;
+            f.inverse_denominator[i] = inverse_d;
+            f.holonomy_scale[i] =
+                P::R::of(0.5) * d * f.inverse_length[i - 1] * inverse_length * inverse_one_plus_cos;
+            // The transport turns about (κb)_i, so the binormal has the same components in
+            // the Bishop frames on both sides of node i: two dot products serve both.
+            let p = [kb.dot(v), -kb.dot(u)];
+            f.bishop_curvature[i] = [p, p];
         }
     }
 

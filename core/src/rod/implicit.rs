@@ -91,10 +91,9 @@ fn cross_columns(e: Vec3) -> [Vec3; 3] {
 
 /// The columns of `∂(κb)/∂e^{i−1}` and `∂(κb)/∂e^i` for `(κb) = 2 e^{i−1}×e^i / d`,
 /// `d = |ê^{i−1}||ê^i| + e^{i−1}·e^i`: `A = (−2[e^i]× − κb e^{iᵀ}) / d`,
-/// `C = (2[e^{i−1}]× − κb e^{i−1ᵀ}) / d` with `[e]× v = e × v`, column `b` of each.
+/// `C = (2[e^{i−1}]× − κb e^{i−1ᵀ}) / d` with `[e]× v = e × v`, column `b` of each, given `1/d`.
 #[inline(always)]
-fn binormal_jacobians(e_prev: Vec3, e_next: Vec3, kb: Vec3, d: Real) -> ([Vec3; 3], [Vec3; 3]) {
-    let inv_d = 1.0 / d;
+fn binormal_jacobians(e_prev: Vec3, e_next: Vec3, kb: Vec3, inv_d: Real) -> ([Vec3; 3], [Vec3; 3]) {
     let two_inv_d = 2.0 * inv_d;
     let kb_d = kb * inv_d;
     let n = cross_columns(e_next);
@@ -143,7 +142,7 @@ fn node_jacobian<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize) ->
         frames.edge[i - 1],
         frames.edge[i],
         frames.curvature_binormal[i],
-        frames.denominator[i],
+        frames.inverse_denominator[i],
     );
     [
         [-a[0], -a[1], -a[2]],
@@ -252,7 +251,7 @@ fn node_blocks<M: Math, const N: usize>(
         frames.edge[i - 1],
         frames.edge[i],
         frames.curvature_binormal[i],
-        frames.denominator[i],
+        frames.inverse_denominator[i],
     );
     let aa = gram(&a, &a);
     let cc = gram(&c, &c);

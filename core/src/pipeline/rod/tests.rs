@@ -105,7 +105,9 @@ fn rest_shapes_stay_at_rest_for_ten_seconds() {
     // a 19 cm human hair (k ≈ 3α/L³ ≈ 3e-6 N/m), moves the tip by up to √(2E/k) ≈ 3e-6 m — the
     // f32 floor for floppy hair. With the firmware scene's air drag (2e-7 kg/s) and the
     // substeps' displacement summed before it is added to the positions, we measure
-    // 0.35–1.00e-6 m (1.0e-6 m: straight, µ = 2, hair-optimised) and bound it by 1.1e-6 m.
+    // 0.30–1.68e-6 m (1.68e-6 m: curved, µ = 1, Newton) and bound it by 2e-6 m. Which shape
+    // is worst moves with the rounding: the frame pass by reflections put the worst at
+    // 1.68e-6 where Rodrigues' transport had it at 1.0e-6, under the same floor.
     let turned = Pose {
         position: Vec3::new(0.1, 0.05, -0.05),
         rotation: crate::math::quat_from_axis_angle::<Libm>(Vec3::new(0.36, 0.48, 0.8), 0.9),
@@ -118,7 +120,7 @@ fn rest_shapes_stay_at_rest_for_ten_seconds() {
                 let drift = rest_drift(shape, mu, twist, turned, 2.0e-7);
                 std::println!("{twist:?} shape {shape} µ {mu}: drift {drift:e} m (turned head)");
                 assert!(
-                    drift < 1.1e-6,
+                    drift < 2.0e-6,
                     "{twist:?} shape {shape} µ {mu}: drift {drift:e} m"
                 );
             }
