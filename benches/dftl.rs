@@ -39,7 +39,7 @@ impl Math for HostMath {
     }
     #[inline(always)]
     fn atan2(y: Real, x: Real) -> Real {
-        libm::atan2f(y, x)
+        hairsim_core::math::atan2(y, x)
     }
 }
 

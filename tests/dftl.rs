@@ -24,7 +24,7 @@ impl Math for HostMath {
         libm::sincosf(x)
     }
     fn atan2(y: Real, x: Real) -> Real {
-        libm::atan2f(y, x)
+        hairsim_core::math::atan2(y, x)
     }
 }
 
