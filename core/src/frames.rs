@@ -14,9 +14,9 @@ use crate::precision::{Precision, Scalar, Vector};
 
 /// The curvature binormal at the node between segments `e_prev` and `e_next` (Kmoch 2009,
 /// Sec. 4; BWR08 eq. 1): `(κb)_i = 2 (e^{i−1} × e^i) / (|ê^{i−1}| |ê^i| + e^{i−1}·e^i)`, with the
-/// *rest* lengths in the denominator. Returns `(κb, d)` with `d` the denominator, which the
-/// gradients divide by. Its length is `2 tan(φ/2)` for a turning angle `φ` when lengths are
-/// at rest.
+/// *rest* lengths in the denominator. Returns `(κb, d, 1/d)` with `d` the denominator, whose
+/// reciprocal the gradients multiply by. Its length is `2 tan(φ/2)` for a turning angle `φ`
+/// when lengths are at rest.
 #[inline(always)]
 #[must_use]
 pub fn curvature_binormal<P: Precision>(
@@ -24,10 +24,14 @@ pub fn curvature_binormal<P: Precision>(
     e_next: P::V,
     rest_length_prev: P::R,
     rest_length_next: P::R,
-) -> (P::V, P::R) {
+) -> (P::V, P::R, P::R) {
     let d = rest_length_prev * rest_length_next + e_prev.dot(e_next);
-    let two = P::R::of(2.0);
-    (e_prev.cross(e_next) * (two / d), d)
+    let inverse_d = P::R::ONE / d;
+    (
+        e_prev.cross(e_next) * (P::R::of(2.0) * inverse_d),
+        d,
+        inverse_d,
+    )
 }
 
 /// The parallel transport of `v` along the rotation about `t_from × t_to` that takes the unit
@@ -179,7 +183,7 @@ mod tests {
         let phi: f64 = 0.7;
         let e0 = DVec3::new(0.01, 0.0, 0.0);
         let e1 = DVec3::new(phi.cos(), phi.sin(), 0.0) * 0.02;
-        let (kb, _) = curvature_binormal::<F64>(e0, e1, 0.01, 0.02);
+        let (kb, _, _) = curvature_binormal::<F64>(e0, e1, 0.01, 0.02);
         assert!((kb.length() - 2.0 * (phi / 2.0).tan()).abs() < 1e-12);
         assert!(kb.x.abs() < 1e-15 && kb.y.abs() < 1e-15 && kb.z > 0.0);
     }

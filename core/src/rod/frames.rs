@@ -6,7 +6,7 @@
 //!
 //! Generic over a [`Precision`] so that the finite-difference tests run in `f64`.
 
-use crate::frames::transport_perpendicular;
+use crate::frames::{curvature_binormal, transport_perpendicular};
 use crate::math::Math;
 use crate::precision::{Precision, Scalar, Vector};
 use crate::strand::Strand;
@@ -129,10 +129,8 @@ impl<P: Precision, const N: usize> RodFrames<P, N> {
             let v = t.cross(u);
             f.bishop_u[i] = u;
             f.bishop_v[i] = v;
-            // (κb)_i = 2 e^{i−1}×e^i / d_i with the rest lengths in d_i (BWR08 eq. 1).
-            let d = rest_length[i - 1] * rest_length[i] + e_prev.dot(e);
-            let inverse_d = P::R::ONE / d;
-            let kb = e_prev.cross(e) * (P::R::of(2.0) * inverse_d);
+            let (kb, d, inverse_d) =
+                curvature_binormal::<P>(e_prev, e, rest_length[i - 1], rest_length[i]);
             f.curvature_binormal[i] = kb;
             f.denominator[i] = d;
             f.inverse_denominator[i] = inverse_d;
