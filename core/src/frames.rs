@@ -91,9 +91,14 @@ pub fn bishop_frame<P: Precision>(tangents: &[P::V], root_frame: P::V, u: &mut [
 
 /// The Bishop frame in time (Kmoch Sec. 5): after a step the root frame `u^0` moves by the
 /// parallel transport that takes the old root tangent to the new one, then is re-orthonormalised
-/// against the new tangent so rounding never accumulates over thousands of steps.
+/// against the new tangent so rounding never accumulates over thousands of steps. A root that
+/// did not turn keeps its frame bit for bit: the transport is the identity, and rounding it
+/// (`t·t` is not always 1 in f32) would turn `θ^0` by an ulp every step.
 #[must_use]
 pub fn transport_in_time<P: Precision>(old_tangent: P::V, new_tangent: P::V, u: P::V) -> P::V {
+    if old_tangent == new_tangent {
+        return u;
+    }
     let moved = parallel_transport::<P>(old_tangent, new_tangent, u);
     orthonormalise::<P>(moved, new_tangent)
         .unwrap_or_else(|| perpendicular_unit_by_reciprocal::<P>(new_tangent))

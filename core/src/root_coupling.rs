@@ -122,13 +122,7 @@ pub fn carry_root_frame<M: Math, const N: usize>(
 ) {
     let state = &mut strand.state;
     let tangent = crate::math::unit::<M>(state.position[1] - state.position[0]);
-    // A root that did not turn keeps its frame bit for bit: the transport is the identity,
-    // and rounding it (`t·t` is not always 1 in f32) would turn θ^0 by an ulp every step.
-    let u = if tangent == old_tangent {
-        state.root_frame
-    } else {
-        transport_in_time::<M>(old_tangent, tangent, state.root_frame)
-    };
+    let u = transport_in_time::<M>(old_tangent, tangent, state.root_frame);
     let rest = &strand.rest;
     let rest_material =
         rest_root_frame::<M>(rest.position[0], rest.position[1], rest.segment_length[0]);
