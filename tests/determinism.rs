@@ -30,3 +30,177 @@ fn glam_math_goes_through_libm() {
         );
     }
 }
+
+/// The rod's blocks (`pipeline::rod::step_block`, strands `W` at a time in lanes) against the
+/// per-strand path, bit for bit, every step of 1,500: in fixed-cost mode, where every lane of
+/// a block takes the same 4 substeps and the lanes run them, and in converge mode on blocks
+/// whose strands differ in their substep count, in the implicit switch (a stiff strand), in
+/// their projection iterations, and in a roll-back (a NaN put into one strand's velocity).
+/// Each of those cases is counted and must have occurred.
+mod rod_blocks {
+    use hairsim_core::collide::{Collider, Shape};
+    use hairsim_core::context::StepContext;
+    use hairsim_core::hash::state_hash;
+    use hairsim_core::rod::frames::RodFrames;
+    use hairsim_core::rod::substeps::{plan, Integration};
+    use hairsim_core::{
+        step_strands, step_strands_in_lanes, Effect, Effects, Libm, Material, Math, Mode, Params,
+        Pose, Real, Shake, StepReport, Strand, Vec3,
+    };
+
+    const N: usize = 32;
+    const STRANDS: usize = 12;
+    const STEPS: u32 = 1500;
+
+    /// What the blocks met: steps of a block whose lanes all took the same substeps (the
+    /// lanes' path), differed in substep count, mixed the implicit step with substeps, or
+    /// differed in projection iterations; and roll-backs.
+    #[derive(Debug, Default)]
+    struct Cases {
+        same_substeps: u32,
+        different_substeps: u32,
+        implicit_beside_explicit: u32,
+        different_iterations: u32,
+        roll_backs: u32,
+    }
+
+    /// A strand of 24 nodes leaving the head along `normal`: straight, wavy or curly.
+    fn strand(s: usize) -> Strand<N> {
+        let a = s as Real * 2.4;
+        let normal = Vec3::new(0.6 * a.cos(), 0.8, 0.6 * a.sin()).normalize();
+        let side = normal.cross(Vec3::Z).normalize_or(Vec3::X);
+        let other = normal.cross(side);
+        let points: Vec<Vec3> = (0..24)
+            .map(|i| {
+                let t = i as Real * 0.01;
+                let wave = match s % 3 {
+                    0 => Vec3::ZERO,
+                    1 => side * (0.004 * (40.0 * t).sin()),
+                    _ => (side * (i as Real).cos() + other * (i as Real).sin()) * 0.004,
+                };
+                normal * (0.1 + t) + wave
+            })
+            .collect();
+        let mut material = Material::HUMAN_HAIR;
+        if s == 5 {
+            // Ten times stiffer: 12 fixed substeps, so the implicit step from the first.
+            material.youngs_modulus *= 10.0;
+        }
+        Strand::from_polyline(&points, &material).unwrap()
+    }
+
+    fn params(mode: Mode) -> Params {
+        let mut p = Params {
+            effects: Effects::from_slice(&[
+                Effect::Gravity,
+                Effect::Drag,
+                Effect::Bending,
+                Effect::Twist,
+                Effect::Inextensibility,
+                Effect::Collisions,
+            ]),
+            ..Params::DEFAULT
+        };
+        p.mode = mode;
+        p
+    }
+
+    /// The plan each strand of `strands` would make for this step (its schedule untouched).
+    fn plans<M: Math>(ctx: &StepContext, strands: &[Strand<N>]) -> Vec<Integration> {
+        let mut frames = RodFrames::<M, N>::empty();
+        strands
+            .iter()
+            .map(|s| {
+                frames.refresh(s);
+                let mut schedule = s.schedule;
+                plan(ctx, &s.rest.rod, &mut schedule, Some(&frames))
+            })
+            .collect()
+    }
+
+    fn check<M: Math, const W: usize>(mode: Mode) -> Cases {
+        let p = params(mode);
+        let colliders = [Collider {
+            shape: Shape::Sphere {
+                centre: Vec3::ZERO,
+                radius: 0.1,
+            },
+            attached_to_head: true,
+        }];
+        let mut reference: Vec<Strand<N>> = (0..STRANDS).map(strand).collect();
+        let mut lanes = reference.clone();
+        let coefficients = p.dftl.at_step(p.dt);
+        let mut cases = Cases::default();
+        let mut previous = Pose::IDENTITY;
+        for k in 0..STEPS {
+            let t = (k + 1) as Real * p.dt;
+            let head = Shake::TEN_RAD_PER_S.pose_at::<Libm>(t);
+            let ctx = StepContext::with_coefficients(&p, coefficients, previous, head, &colliders)
+                .at_time(t);
+            previous = head;
+            if k == 700 && mode == Mode::Converge {
+                for strands in [&mut reference, &mut lanes] {
+                    strands[2].state.velocity[12].x = Real::NAN;
+                }
+            }
+            let plans = plans::<M>(&ctx, &reference);
+            let mut iterations = Vec::new();
+            let mut expected = StepReport::default();
+            for (s, strand) in reference.chunks_mut(1).enumerate() {
+                let mut report = StepReport::default();
+                step_strands::<M, N>(&ctx, strand, s as u32, &[], None, &mut report);
+                iterations.push(report.iterations_max);
+                expected.merge(&report);
+            }
+            let mut report = StepReport::default();
+            step_strands_in_lanes::<M, N, W>(&ctx, &mut lanes, 0, &[], None, &mut report);
+            assert_eq!(report.stage_runs, expected.stage_runs, "step {k}");
+            assert_eq!(report.rolled_back, expected.rolled_back, "step {k}");
+            assert_eq!(
+                report.iterations_total, expected.iterations_total,
+                "step {k}"
+            );
+            assert_eq!(state_hash(&lanes), state_hash(&reference), "step {k}");
+            cases.roll_backs += report.rolled_back;
+            for (block, its) in plans.chunks(W).zip(iterations.chunks(W)) {
+                let substeps: Vec<u32> = block
+                    .iter()
+                    .filter_map(|plan| match plan {
+                        Integration::Explicit(k) => Some(*k),
+                        Integration::Implicit => None,
+                    })
+                    .collect();
+                let explicit_differ = substeps.iter().any(|&k| k != substeps[0]);
+                cases.same_substeps += u32::from(substeps.len() == block.len() && !explicit_differ);
+                cases.different_substeps += u32::from(explicit_differ);
+                cases.implicit_beside_explicit +=
+                    u32::from(!substeps.is_empty() && substeps.len() < block.len());
+                cases.different_iterations += u32::from(its.iter().any(|&i| i != its[0]));
+            }
+        }
+        assert_eq!(lanes, reference);
+        eprintln!("{mode:?}, {W} lanes: {cases:?}");
+        cases
+    }
+
+    #[test]
+    fn blocks_give_the_per_strand_bits() {
+        for cases in [
+            check::<Libm, 4>(Mode::FixedCost),
+            check::<Libm, 8>(Mode::FixedCost),
+        ] {
+            assert!(cases.same_substeps > 0, "{cases:?}");
+            assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+        }
+        for cases in [
+            check::<Libm, 4>(Mode::Converge),
+            check::<Libm, 8>(Mode::Converge),
+        ] {
+            assert!(cases.same_substeps > 0, "{cases:?}");
+            assert!(cases.different_substeps > 0, "{cases:?}");
+            assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+            assert!(cases.different_iterations > 0, "{cases:?}");
+            assert!(cases.roll_backs > 0, "{cases:?}");
+        }
+    }
+}

@@ -10,7 +10,7 @@
 //! All functions are generic over a [`Precision`]: the step runs them in `f32` through its math
 //! backend, finite-difference tests in `f64`.
 
-use crate::precision::{Precision, Scalar, Vector};
+use crate::precision::{Arithmetic, Kernel, Precision, Scalar, Vector};
 
 /// The curvature binormal at the node between segments `e_prev` and `e_next` (Kmoch 2009,
 /// Sec. 4; BWR08 eq. 1): `(κb)_i = 2 (e^{i−1} × e^i) / (|ê^{i−1}| |ê^i| + e^{i−1}·e^i)`, with the
@@ -19,7 +19,7 @@ use crate::precision::{Precision, Scalar, Vector};
 /// when lengths are at rest.
 #[inline(always)]
 #[must_use]
-pub fn curvature_binormal<P: Precision>(
+pub fn curvature_binormal<P: Kernel>(
     e_prev: P::V,
     e_next: P::V,
     rest_length_prev: P::R,
@@ -60,18 +60,16 @@ pub fn parallel_transport<P: Precision>(t_from: P::V, t_to: P::V, v: P::V) -> P:
 /// when the tangents are (nearly) opposite, as [`parallel_transport`].
 #[inline(always)]
 #[must_use]
-pub fn transport_perpendicular<P: Precision>(
+pub fn transport_perpendicular<P: Kernel>(
     t_from: P::V,
     t_to: P::V,
     v: P::V,
     inverse_one_plus_cos: P::R,
 ) -> P::V {
     // 1/(1 + c) ≥ 1e6 where `parallel_transport` tests 1 + c ≤ 1e-6 (and NaN fails both).
-    let transports = inverse_one_plus_cos > P::R::ZERO && inverse_one_plus_cos < P::R::of(1.0e6);
-    if !transports {
-        return v;
-    }
-    v - (t_from + t_to) * (t_to.dot(v) * inverse_one_plus_cos)
+    let transports = P::R::ZERO.lt(inverse_one_plus_cos) & inverse_one_plus_cos.lt(P::R::of(1.0e6));
+    let transported = v - (t_from + t_to) * (t_to.dot(v) * inverse_one_plus_cos);
+    P::V::select(transports, transported, v)
 }
 
 /// The Bishop frame in space (Kmoch Sec. 5): `u^0` given at the root, then

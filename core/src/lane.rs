@@ -9,9 +9,11 @@
 //! `V3`/`Q` spell out their sums in the order of glam's scalar `Vec3` and `math.rs`'s
 //! quaternion helpers.
 
-use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+use core::marker::PhantomData;
+use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use crate::math::{Math, Quat, Real, Vec3};
+use crate::precision::{Arithmetic, Kernel, Vector};
 
 /// A scalar or a fixed-width bundle of scalars, operated on lane by lane.
 pub trait Lane:
@@ -152,6 +154,59 @@ impl<const W: usize> Not for WideMask<W> {
     #[inline(always)]
     fn not(self) -> Self {
         WideMask(self.0.map(|x| !x))
+    }
+}
+
+macro_rules! lanewise_assign {
+    ($trait:ident, $method:ident, $op:tt) => {
+        impl<const W: usize> $trait for Wide<W> {
+            #[inline(always)]
+            fn $method(&mut self, other: Self) {
+                for (a, b) in self.0.iter_mut().zip(other.0) {
+                    *a $op b;
+                }
+            }
+        }
+    };
+}
+lanewise_assign!(AddAssign, add_assign, +=);
+lanewise_assign!(SubAssign, sub_assign, -=);
+lanewise_assign!(MulAssign, mul_assign, *=);
+
+/// The rod's kernels (`precision::Kernel`) on `W` lanes: each lane's operations are the
+/// scalar kernel's, in its order, so each lane gets the bits that strand gets alone.
+impl<const W: usize> Arithmetic for Wide<W> {
+    type Mask = WideMask<W>;
+    const ZERO: Self = Wide([0.0; W]);
+    const ONE: Self = Wide([1.0; W]);
+    #[inline(always)]
+    fn of(x: f32) -> Self {
+        Wide([x; W])
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> WideMask<W> {
+        <Self as Lane>::lt(self, other)
+    }
+    #[inline(always)]
+    fn select(mask: WideMask<W>, a: Self, b: Self) -> Self {
+        <Self as Lane>::select(mask, a, b)
+    }
+    #[inline(always)]
+    fn any(mask: WideMask<W>) -> bool {
+        <Self as Lane>::any(mask)
+    }
+}
+
+/// The kernel of `W` lanes with the backend `M`'s square root in each.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Lanes<M, const W: usize>(PhantomData<M>);
+
+impl<M: Math, const W: usize> Kernel for Lanes<M, W> {
+    type R = Wide<W>;
+    type V = V3<Wide<W>>;
+    #[inline(always)]
+    fn sqrt(x: Wide<W>) -> Wide<W> {
+        Lane::sqrt::<M>(x)
     }
 }
 
@@ -297,6 +352,76 @@ impl<T: Lane> Sub for V3<T> {
             y: self.y - o.y,
             z: self.z - o.z,
         }
+    }
+}
+
+impl<T: Lane> Neg for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        V3 {
+            x: -self.x,
+            y: -self.y,
+            z: -self.z,
+        }
+    }
+}
+
+impl<T: Lane> Mul<T> for V3<T> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(self, s: T) -> Self {
+        self.scale(s)
+    }
+}
+
+impl<T: Lane> AddAssign for V3<T> {
+    #[inline(always)]
+    fn add_assign(&mut self, o: Self) {
+        *self = *self + o;
+    }
+}
+
+impl<T: Lane> SubAssign for V3<T> {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: Self) {
+        *self = *self - o;
+    }
+}
+
+impl<const W: usize> Vector<Wide<W>> for V3<Wide<W>> {
+    const ZERO: Self = V3 {
+        x: Wide::ZERO,
+        y: Wide::ZERO,
+        z: Wide::ZERO,
+    };
+    #[inline(always)]
+    fn dot(self, other: Self) -> Wide<W> {
+        V3::dot(self, other)
+    }
+    #[inline(always)]
+    fn cross(self, other: Self) -> Self {
+        V3::cross(self, other)
+    }
+    #[inline(always)]
+    fn select(mask: WideMask<W>, a: Self, b: Self) -> Self {
+        V3::select(mask, a, b)
+    }
+}
+
+impl<const W: usize> V3<Wide<W>> {
+    /// Lane `lane` as a vector.
+    #[inline(always)]
+    #[must_use]
+    pub fn lane(&self, lane: usize) -> Vec3 {
+        Vec3::new(self.x.0[lane], self.y.0[lane], self.z.0[lane])
+    }
+    /// Writes `v` into lane `lane`.
+    #[inline(always)]
+    pub fn set_lane(&mut self, lane: usize, v: Vec3) {
+        self.x.0[lane] = v.x;
+        self.y.0[lane] = v.y;
+        self.z.0[lane] = v.z;
     }
 }
 
@@ -462,7 +587,7 @@ mod tests {
         assert_eq!(p, math::quat_normalize::<Libm>(math::quat_mul(q, q)));
         let wide = Q::<Wide<4>>::splat(q).rotate(V3::splat(v));
         assert_eq!(wide.y.0, [r.y; 4]);
-        let m = Wide([1.0, -1.0, 2.0, 0.0]).lt(Wide::splat(0.5));
+        let m = Lane::lt(Wide([1.0, -1.0, 2.0, 0.0]), Wide::splat(0.5));
         assert_eq!(m.0, [false, true, false, true]);
     }
 }

@@ -10,18 +10,19 @@
 //! names (`dot`, `cross`) sum left to right in scalar code on every target.
 
 use core::fmt::Debug;
-use core::ops::{Add, AddAssign, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+use core::ops::{Add, AddAssign, BitAnd, Div, Mul, MulAssign, Neg, Sub, SubAssign};
 
 use glam::DVec3;
 
 use crate::math::{Math, Real, Vec3};
 
-/// A floating-point scalar: `f32` or `f64`.
-pub trait Scalar:
+/// The arithmetic a kernel is written in: a scalar (`f32`, `f64`) or `W` lanes of `f32`, one
+/// strand per lane (`lane::Wide`). Only `+ − × ÷`, constants, and comparisons that give a
+/// mask; a branch on a value becomes [`Arithmetic::select`], so the same kernel runs one
+/// strand or a block and gives each lane the bits it gives that strand alone.
+pub trait Arithmetic:
     Copy
     + Debug
-    + Default
-    + PartialOrd
     + Add<Output = Self>
     + Sub<Output = Self>
     + Mul<Output = Self>
@@ -32,16 +33,61 @@ pub trait Scalar:
     + MulAssign
     + 'static
 {
+    /// One boolean per lane (`bool` for a scalar).
+    type Mask: Copy + BitAnd<Output = Self::Mask>;
     /// 0.
     const ZERO: Self;
     /// 1.
     const ONE: Self;
+    /// The `f32` value `x` (exact), in every lane.
+    fn of(x: f32) -> Self;
+    /// `self < other`, per lane (false where either is NaN).
+    fn lt(self, other: Self) -> Self::Mask;
+    /// Per lane `if mask { a } else { b }`.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// Whether any lane of `mask` is set: only to skip work no lane selects, never to change
+    /// a lane's result.
+    fn any(mask: Self::Mask) -> bool;
+}
+
+macro_rules! scalar_arithmetic {
+    ($ty:ty) => {
+        impl Arithmetic for $ty {
+            type Mask = bool;
+            const ZERO: Self = 0.0;
+            const ONE: Self = 1.0;
+            #[inline(always)]
+            fn of(x: f32) -> Self {
+                x.into()
+            }
+            #[inline(always)]
+            fn lt(self, other: Self) -> bool {
+                self < other
+            }
+            #[inline(always)]
+            fn select(mask: bool, a: Self, b: Self) -> Self {
+                if mask {
+                    a
+                } else {
+                    b
+                }
+            }
+            #[inline(always)]
+            fn any(mask: bool) -> bool {
+                mask
+            }
+        }
+    };
+}
+scalar_arithmetic!(f32);
+scalar_arithmetic!(f64);
+
+/// A floating-point scalar: `f32` or `f64`.
+pub trait Scalar: Arithmetic<Mask = bool> + Default + PartialOrd {
     /// π.
     const PI: Self;
     /// 1/π.
     const FRAC_1_PI: Self;
-    /// The `f32` value `x` in this precision (exact).
-    fn of(x: f32) -> Self;
     /// The value rounded to `f32`.
     fn to_f32(self) -> f32;
     /// `|x|`.
@@ -57,14 +103,8 @@ pub trait Scalar:
 }
 
 impl Scalar for f32 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
     const PI: Self = core::f32::consts::PI;
     const FRAC_1_PI: Self = core::f32::consts::FRAC_1_PI;
-    #[inline(always)]
-    fn of(x: f32) -> Self {
-        x
-    }
     #[inline(always)]
     fn to_f32(self) -> f32 {
         self
@@ -99,14 +139,8 @@ impl Scalar for f32 {
 }
 
 impl Scalar for f64 {
-    const ZERO: Self = 0.0;
-    const ONE: Self = 1.0;
     const PI: Self = core::f64::consts::PI;
     const FRAC_1_PI: Self = core::f64::consts::FRAC_1_PI;
-    #[inline(always)]
-    fn of(x: f32) -> Self {
-        f64::from(x)
-    }
     #[inline(always)]
     fn to_f32(self) -> f32 {
         self as f32
@@ -140,8 +174,8 @@ impl Scalar for f64 {
     }
 }
 
-/// A 3-vector over the scalar `R`: glam's `Vec3` or `DVec3`.
-pub trait Vector<R: Scalar>:
+/// A 3-vector over the arithmetic `R`: glam's `Vec3` or `DVec3`, or `lane::V3` of lanes.
+pub trait Vector<R: Arithmetic>:
     Copy
     + Debug
     + PartialEq
@@ -159,6 +193,8 @@ pub trait Vector<R: Scalar>:
     fn dot(self, other: Self) -> R;
     /// The cross product.
     fn cross(self, other: Self) -> Self;
+    /// Per lane `if mask { a } else { b }`.
+    fn select(mask: R::Mask, a: Self, b: Self) -> Self;
 }
 
 impl Vector<f32> for Vec3 {
@@ -170,6 +206,14 @@ impl Vector<f32> for Vec3 {
     #[inline(always)]
     fn cross(self, other: Self) -> Self {
         Vec3::cross(self, other)
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask {
+            a
+        } else {
+            b
+        }
     }
 }
 
@@ -183,16 +227,30 @@ impl Vector<f64> for DVec3 {
     fn cross(self, other: Self) -> Self {
         DVec3::cross(self, other)
     }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask {
+            a
+        } else {
+            b
+        }
+    }
+}
+
+/// What the lane kernels (the rod's frame pass, elastic forces and integration) are written
+/// over: an arithmetic, a vector and the square root. Every [`Precision`] is one, and so is
+/// `lane::Lanes`, `W` strands at once.
+pub trait Kernel: Copy + 'static {
+    /// The scalar type, or lanes of it.
+    type R: Arithmetic;
+    /// The vector type.
+    type V: Vector<Self::R>;
+    /// Correctly rounded square root (per lane).
+    fn sqrt(x: Self::R) -> Self::R;
 }
 
 /// A scalar, a vector and the few transcendental functions the kernels call.
-pub trait Precision: Copy + 'static {
-    /// The scalar type.
-    type R: Scalar;
-    /// The vector type.
-    type V: Vector<Self::R>;
-    /// Correctly rounded square root.
-    fn sqrt(x: Self::R) -> Self::R;
+pub trait Precision: Kernel<R: Scalar> {
     /// `(sin x, cos x)`.
     fn sin_cos(x: Self::R) -> (Self::R, Self::R);
     /// Four-quadrant arctangent of `y / x`.
@@ -203,14 +261,17 @@ pub trait Precision: Copy + 'static {
     fn to_vec3(v: Self::V) -> Vec3;
 }
 
-/// Every math backend is the `f32` precision the step runs in.
-impl<M: Math> Precision for M {
+impl<M: Math> Kernel for M {
     type R = Real;
     type V = Vec3;
     #[inline(always)]
     fn sqrt(x: Real) -> Real {
         M::sqrt(x)
     }
+}
+
+/// Every math backend is the `f32` precision the step runs in.
+impl<M: Math> Precision for M {
     #[inline(always)]
     fn sin_cos(x: Real) -> (Real, Real) {
         M::sin_cos(x)
@@ -234,13 +295,16 @@ impl<M: Math> Precision for M {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct F64;
 
-impl Precision for F64 {
+impl Kernel for F64 {
     type R = f64;
     type V = DVec3;
     #[inline(always)]
     fn sqrt(x: f64) -> f64 {
         libm::sqrt(x)
     }
+}
+
+impl Precision for F64 {
     #[inline(always)]
     fn sin_cos(x: f64) -> (f64, f64) {
         libm::sincos(x)
@@ -261,7 +325,7 @@ impl Precision for F64 {
 
 /// Length of `v` with the precision's square root.
 #[inline(always)]
-pub fn length<P: Precision>(v: P::V) -> P::R {
+pub fn length<P: Kernel>(v: P::V) -> P::R {
     P::sqrt(v.dot(v))
 }
 

@@ -17,8 +17,8 @@ use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
-    step_blocks, step_strands, Collider, Grab, Math, Params, Pose, Real, Solver, Stage, StepReport,
-    Strand, Vec3,
+    step_blocks, step_strands, step_strands_in_lanes, Collider, Grab, Math, Params, Pose, Real,
+    Solver, Stage, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -29,6 +29,8 @@ pub use crate::scene::start::{scene_inputs, time_after, StepInputs};
 
 /// Lanes of the DFTL blocks.
 const LANES: usize = RECOMMENDED_LANES;
+/// Lanes of the rod's blocks (`hairsim_core::pipeline::rod::step_block`).
+const ROD_LANES: usize = 4;
 
 /// The backend `M` with the hardware's square root, which the compiler can vectorise
 /// (`libm::sqrtf` is a scalar `sqrtss`). [`Math::sqrt`] is correctly rounded in every backend
@@ -83,6 +85,8 @@ pub struct Sim<const N: usize, M: Math> {
     /// DFTL only: each block of `block` strands as `block.div_ceil(LANES)` SoA blocks, in
     /// strand order (rest data loaded once; the state copied in and out every step).
     dftl_blocks: Vec<DftlBlock<LANES, N>>,
+    /// How the strands are stepped.
+    layout: Layout,
     dftl: DftlCoefficients,
     accelerations: Vec<Vec3>,
     /// One report per block of strands, reused every step (a step allocates nothing).
@@ -150,6 +154,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
             sph,
             block,
             dftl_blocks,
+            layout,
             // Computed once, as `World::configure` does (two divisions, never per step).
             dftl: prepared.params.dftl.at_step(prepared.params.dt),
             pool,
@@ -242,6 +247,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
             block: self.block,
             grabs: &self.grabs,
             accelerations: hair_hair.then_some(self.accelerations.as_slice()),
+            lanes: self.layout == Layout::Blocks,
         };
         let reports = &mut self.block_reports;
         let parallel = self.pool.as_ref().filter(|_| reports.len() > 1);
@@ -263,6 +269,8 @@ struct Blocks<'a> {
     block: usize,
     grabs: &'a [Grab],
     accelerations: Option<&'a [Vec3]>,
+    /// Rod strands in lanes of [`ROD_LANES`].
+    lanes: bool,
 }
 
 impl Blocks<'_> {
@@ -284,7 +292,13 @@ impl Blocks<'_> {
             *r = StepReport::default();
             let acc = self.of_block::<N>(b, strands.len());
             let first = (b * self.block) as u32;
-            step_strands::<M, N>(self.ctx, strands, first, self.grabs, acc, r);
+            let (ctx, grabs) = (self.ctx, self.grabs);
+            if self.lanes {
+                type L<M> = VectorSqrt<M>;
+                step_strands_in_lanes::<L<M>, N, ROD_LANES>(ctx, strands, first, grabs, acc, r);
+            } else {
+                step_strands::<M, N>(ctx, strands, first, grabs, acc, r);
+            }
         };
         match parallel {
             Some(pool) => pool.install(|| {

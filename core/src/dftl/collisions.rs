@@ -32,7 +32,7 @@ pub fn resolve<M: Math, T: Lane>(
         // mass is rest data: a `1/inverse_mass` here was hoisted out of the branch by the
         // compiler, a 14-cycle division at every node on the Cortex-M4F.)
         if T::any(inside) {
-            *push = *push + V3::select(active, (pushed - x).scale(mass), V3::zero());
+            *push += V3::select(active, (pushed - x).scale(mass), V3::zero());
         }
         x = pushed;
         contact = contact | inside;

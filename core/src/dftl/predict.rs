@@ -24,7 +24,7 @@ pub fn acceleration<T: Lane>(
     let mut a = V3::splat(setup.base_acceleration);
     if setup.drag {
         let nu = T::splat(setup.drag_coefficient);
-        a = a - velocity.scale(nu / (mass + nu * T::splat(setup.dt)));
+        a -= velocity.scale(nu / (mass + nu * T::splat(setup.dt)));
     }
     V3::select(has_extra, a + extra, a)
 }

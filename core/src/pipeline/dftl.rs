@@ -275,7 +275,7 @@ pub fn advance<M: Math, T: Lane>(
         let (previous, tangent, normal) = (chain.position, chain.tangent, chain.normal);
         let rest = (node.local_rest, node.root_distance);
         local = shape::local_correction(setup, previous, tangent, normal, rest.0, rest.1, x);
-        x = x + local;
+        x += local;
     }
     // Line 19: follow the leader, eq. (10); its direction is the frame's next tangent.
     let (mut tangent, mut tangent_known) = (chain.tangent, T::mask(false));
@@ -451,7 +451,7 @@ fn block_pass<
         let (x_star, b) = (chain.position, &mut *block);
         let (p, at) = (&mut pending, handing_lanes(k, nodes_real));
         let written = hand_on_lanes(&setup, b, at, p, x_star, (zero, zero));
-        velocity_total = velocity_total + written;
+        velocity_total += written;
     }
     tally_lanes::<M, W, N>(ctx, &setup, block, &measures, &collider_push, report);
     velocity_total
@@ -505,7 +505,7 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     };
     let pending = &mut *carried.pending;
     let written = hand_on_lanes(setup, block, at, pending, x_star, (local, inextensible));
-    *carried.velocity_total = *carried.velocity_total + written;
+    *carried.velocity_total += written;
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
     *carried.previous_contact = (active & next.contact) | (!active & *carried.previous_contact);
 }

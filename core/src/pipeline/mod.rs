@@ -63,6 +63,28 @@ pub fn step_strands<M: Math, const N: usize>(
     }
 }
 
+/// [`step_strands`] with the rod's strands stepped `W` at a time in lanes
+/// ([`rod::step_block`]): the same bits, whatever `W`. DFTL strands step one by one here (its
+/// blocks are [`dftl::step_blocks`]'s).
+pub fn step_strands_in_lanes<M: Math, const N: usize, const W: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    first_strand: u32,
+    grabs: &[Grab],
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    if ctx.params.solver != Solver::Rod {
+        return step_strands::<M, N>(ctx, strands, first_strand, grabs, accelerations, report);
+    }
+    for (b, block) in strands.chunks_mut(W.max(1)).enumerate() {
+        let first = b * W.max(1);
+        let accelerations = accelerations.and_then(|a| a.get(first * N..(first + block.len()) * N));
+        let index = first_strand + first as u32;
+        rod::step_block::<M, N, W>(block, ctx, grabs, index, accelerations, report);
+    }
+}
+
 /// What a step reads and changes of its caller's world.
 #[derive(Debug)]
 pub struct Stepping<'a, const N: usize> {

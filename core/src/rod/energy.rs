@@ -19,14 +19,14 @@
 //! Everything is generic over a [`Precision`] so the finite-difference tests run in `f64`.
 
 pub use super::frames::{material_angles, material_curvature, representative_near, RodFrames};
-use super::{ClampedSegments, ElasticTerms};
-use crate::precision::{Precision, Scalar, Vector};
+use super::{ClampedLanes, ClampedSegments, ElasticTerms};
+use crate::precision::{Arithmetic, Kernel, Precision, Scalar, Vector};
 use crate::strand::RodRest;
 
 /// `B^j = diag(µα^j, α^j)`, or zero when bending is off.
 #[inline(always)]
 #[must_use]
-pub fn bending_matrix<const N: usize, R: Scalar>(
+pub fn bending_matrix<const N: usize, R: Arithmetic>(
     rest: &RodRest<N, R>,
     terms: ElasticTerms,
     j: usize,
@@ -40,7 +40,10 @@ pub fn bending_matrix<const N: usize, R: Scalar>(
 /// `β`, or zero when twist is off.
 #[inline(always)]
 #[must_use]
-pub fn twist_stiffness<const N: usize, R: Scalar>(rest: &RodRest<N, R>, terms: ElasticTerms) -> R {
+pub fn twist_stiffness<const N: usize, R: Arithmetic>(
+    rest: &RodRest<N, R>,
+    terms: ElasticTerms,
+) -> R {
     if terms.twist {
         rest.twist_stiffness
     } else {
@@ -106,7 +109,7 @@ pub fn elastic_energy<P: Precision, const N: usize>(
 /// `∂E_bend/∂θ^j` from node `i` (frame `j = i − 1 + k`): `(1/l̂_i)(ω₂ (Bδ)₁ − ω₁ (Bδ)₂)`, and
 /// the vector `(1/l̂_i)(m2^j (Bδ)₁ − m1^j (Bδ)₂) = ∂E/∂(κb)_i` from the same term.
 #[inline(always)]
-fn bending_terms<P: Precision, const N: usize>(
+fn bending_terms<P: Kernel, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,
@@ -157,7 +160,7 @@ pub fn bending_twist_derivative<P: Precision, const N: usize>(
 /// `∂E_twist/∂θ^j = 2β[(m_j − m̂_j)/l̂_j − (m_{j+1} − m̂_{j+1})/l̂_{j+1}]` (terms at nodes 0 and
 /// `n + 1` dropped).
 #[must_use]
-pub fn twist_twist_derivative<const N: usize, R: Scalar>(
+pub fn twist_twist_derivative<const N: usize, R: Arithmetic>(
     rest: &RodRest<N, R>,
     terms: ElasticTerms,
     theta: &[R],
@@ -221,13 +224,13 @@ pub fn elastic_forces<P: Precision, const N: usize>(
 }
 
 /// [`elastic_forces`] with `(cos θ^j, sin θ^j)` already computed (substeps at fixed `θ` share
-/// them).
-pub fn elastic_forces_with_angles<P: Precision, const N: usize>(
+/// them), on one strand or on `W` in lanes (`lane::Lanes`, `clamped` then one set per lane).
+pub fn elastic_forces_with_angles<P: Kernel, C: ClampedLanes<P::R>, const N: usize>(
     frames: &RodFrames<P, N>,
     theta: &[P::R],
     cos_sin: &[[P::R; 2]; N],
     rest: &RodRest<N, P::R>,
-    clamped: &ClampedSegments,
+    clamped: &C,
     terms: ElasticTerms,
     forces: &mut [P::V],
 ) {
@@ -251,8 +254,10 @@ pub fn elastic_forces_with_angles<P: Precision, const N: usize>(
         let bend_k = g_here + carried;
         carried = g_prev;
         let mut w = -bend_k;
-        if clamped.contains(k) {
-            w += bend_k + twist_twist_derivative(rest, terms, theta, k, n);
+        let held = clamped.clamped(k);
+        if P::R::any(held) {
+            let with_twist = w + (bend_k + twist_twist_derivative(rest, terms, theta, k, n));
+            w = P::R::select(held, with_twist, w);
         }
         suffix += w;
         // Curvature binormal gradient: ∂E/∂x from (κb)_k.

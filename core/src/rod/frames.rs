@@ -8,7 +8,7 @@
 
 use crate::frames::{curvature_binormal, transport_perpendicular};
 use crate::math::Math;
-use crate::precision::{Precision, Scalar, Vector};
+use crate::precision::{Arithmetic, Kernel, Precision, Scalar, Vector};
 use crate::strand::Strand;
 
 /// The representative of the direction `(cos φ, sin φ)` (an unoriented line, defined mod π)
@@ -33,7 +33,7 @@ pub fn representative_near<R: Scalar>(
 /// the Bishop frame in space from the root frame `u^0`, and the binormals' Bishop components.
 /// Computed once per force evaluation and shared by the energy, forces and twist.
 #[derive(Clone, Debug)]
-pub struct RodFrames<P: Precision, const N: usize> {
+pub struct RodFrames<P: Kernel, const N: usize> {
     /// Nodes in use.
     pub nodes: usize,
     /// `e^j = x_{j+1} − x_j`.
@@ -64,7 +64,7 @@ pub struct RodFrames<P: Precision, const N: usize> {
     pub bishop_curvature: [[[P::R; 2]; 2]; N],
 }
 
-impl<P: Precision, const N: usize> RodFrames<P, N> {
+impl<P: Kernel, const N: usize> RodFrames<P, N> {
     /// The frames of the polyline `positions` (≤ `N` nodes) with root Bishop vector
     /// `root_frame` and rest segment lengths `rest_length`.
     #[must_use]
@@ -179,7 +179,7 @@ pub fn material_angles<P: Precision, const N: usize>(theta: &[P::R]) -> [[P::R; 
 /// rotated by `θ` (given as `(cos θ, sin θ)`). `∂ω/∂θ = (ω₂, −ω₁) = −Jω`.
 #[inline(always)]
 #[must_use]
-pub fn material_curvature<R: Scalar>(p: [R; 2], cos_sin: [R; 2]) -> [R; 2] {
+pub fn material_curvature<R: Arithmetic>(p: [R; 2], cos_sin: [R; 2]) -> [R; 2] {
     let [c, s] = cos_sin;
     [c * p[0] + s * p[1], c * p[1] - s * p[0]]
 }

@@ -39,7 +39,7 @@
 
 use super::frames::RodFrames;
 use crate::context::StepContext;
-use crate::forces::{acceleration, drag};
+use crate::forces::External;
 use crate::math::{Math, Real, Vec3};
 use crate::strand::{RodRest, Strand};
 
@@ -552,7 +552,7 @@ impl<const N: usize> BendingSystem<N> {
 /// Kmoch 2009 Algorithm 1 line 4 as one linearly implicit step of `h = dt` for the bending
 /// (see the module documentation): `(M + h² H̃) v⁺ = M (v + h a)` and `x⁺ = x + h v⁺`, with
 /// `a` the acceleration of the explicit step from the elastic forces `forces` and the
-/// external forces ([`crate::forces::acceleration`]), and `H̃` assembled at `frames`, those of
+/// external forces ([`crate::forces::External::acceleration`]), and `H̃` assembled at `frames`, those of
 /// the centreline the step starts from. Nodes 0 and 1 stay put; `held_velocity` is the
 /// velocity the head gives them this step (`root_coupling::held_velocity`), a boundary
 /// condition of the solve.
@@ -569,7 +569,7 @@ pub fn step<M: Math, const N: usize>(
     let mut system = BendingSystem::<N>::default();
     system.assemble(frames, &strand.rest.mass, &strand.rest.rod, h);
     system.factor();
-    let drag = drag(ctx);
+    let external = External::<M>::of(ctx);
     // Right-hand side M (v + h a), with a as in the explicit step.
     let mut rhs = [[0.0; 3]; N];
     let state = &mut strand.state;
@@ -582,7 +582,7 @@ pub fn step<M: Math, const N: usize>(
         .take(n)
         .skip(2);
     for (i, ((slot, v), (force, (mass, inverse_mass)))) in nodes {
-        let a = acceleration(ctx, *force, *v, drag, *inverse_mass, accelerations, i);
+        let a = external.acceleration(*force, *v, *inverse_mass, accelerations, i);
         *slot = ((*v + a * h) * *mass).to_array();
     }
     BendingSystem::move_held_nodes(frames, &rest.rod, h, held_velocity, &mut rhs);

@@ -12,7 +12,10 @@
 
 use crate::context::Gates;
 use crate::grab::{Grab, GrabStatus};
+use crate::lane::{Wide, WideMask};
+use crate::precision::{Arithmetic, Scalar};
 
+pub mod block;
 pub mod energy;
 pub mod frames;
 pub mod implicit;
@@ -102,6 +105,27 @@ impl ClampedSegments {
         self.segments[..self.count as usize]
             .iter()
             .map(|&s| s as usize)
+    }
+}
+
+/// The clamped sets of the strands a kernel runs on: one strand's [`ClampedSegments`], or one
+/// per lane of a block.
+pub trait ClampedLanes<R: Arithmetic> {
+    /// Whether segment `segment` is clamped, per lane.
+    fn clamped(&self, segment: usize) -> R::Mask;
+}
+
+impl<R: Scalar> ClampedLanes<R> for ClampedSegments {
+    #[inline(always)]
+    fn clamped(&self, segment: usize) -> bool {
+        self.contains(segment)
+    }
+}
+
+impl<const W: usize> ClampedLanes<Wide<W>> for [ClampedSegments; W] {
+    #[inline(always)]
+    fn clamped(&self, segment: usize) -> WideMask<W> {
+        WideMask(core::array::from_fn(|lane| self[lane].contains(segment)))
     }
 }
 

@@ -24,7 +24,7 @@ use crate::context::StepContext;
 use crate::frames::{angle_in_frame, material_frame, parallel_transport, unwrap_near};
 use crate::math::{Math, Real};
 use crate::params::Mode;
-use crate::precision::{Precision, Scalar, Vector};
+use crate::precision::{Arithmetic, Precision, Scalar, Vector};
 use crate::report::{Flags, Stage, StepReport};
 use crate::strand::{RodRest, Strand};
 
