@@ -42,7 +42,7 @@ mod rod_blocks {
     use hairsim_core::context::StepContext;
     use hairsim_core::hash::state_hash;
     use hairsim_core::rod::frames::RodFrames;
-    use hairsim_core::rod::substeps::{plan, Integration};
+    use hairsim_core::rod::substeps::{plan, smallest_binormal_denominator, Integration};
     use hairsim_core::{
         step_strands, step_strands_in_lanes, Effect, Effects, Libm, Material, Math, Mode, Params,
         Pose, Real, Shake, StepReport, Strand, Vec3,
@@ -113,7 +113,9 @@ mod rod_blocks {
             .map(|s| {
                 frames.refresh(s);
                 let mut schedule = s.schedule;
-                plan(ctx, &s.rest.rod, &mut schedule, Some(&frames))
+                plan(ctx, &s.rest.rod, &mut schedule, || {
+                    smallest_binormal_denominator(&frames, &s.rest.rod.rest_length)
+                })
             })
             .collect()
     }

@@ -19,6 +19,7 @@
 
 pub mod dftl;
 pub mod rod;
+pub mod rod_lanes;
 
 use crate::collide::Collider;
 use crate::context::StepContext;
@@ -64,7 +65,7 @@ pub fn step_strands<M: Math, const N: usize>(
 }
 
 /// [`step_strands`] with the rod's strands stepped `W` at a time in lanes
-/// ([`rod::step_block`]): the same bits, whatever `W`. DFTL strands step one by one here (its
+/// ([`rod_lanes::step_block`]): the same bits, whatever `W`. DFTL strands step one by one here (its
 /// blocks are [`dftl::step_blocks`]'s).
 pub fn step_strands_in_lanes<M: Math, const N: usize, const W: usize>(
     ctx: &StepContext,
@@ -81,7 +82,7 @@ pub fn step_strands_in_lanes<M: Math, const N: usize, const W: usize>(
         let first = b * W.max(1);
         let accelerations = accelerations.and_then(|a| a.get(first * N..(first + block.len()) * N));
         let index = first_strand + first as u32;
-        rod::step_block::<M, N, W>(block, ctx, grabs, index, accelerations, report);
+        rod_lanes::step_block::<M, N, W>(block, ctx, grabs, index, accelerations, report);
     }
 }
 

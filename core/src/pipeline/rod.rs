@@ -18,18 +18,18 @@
 //! [`implicit_bending`].
 
 use crate::context::StepContext;
-use crate::forces::{drag, External};
+use crate::forces::External;
 use crate::grab::Grab;
 use crate::guard::{guard, sound};
-use crate::lane::{Lane, Lanes, Wide, V3};
 use crate::math::{unit, Math, Real, Vec3};
 use crate::projection::project_constraints;
 use crate::report::{Stage, StepReport};
-use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
 use crate::rod::frames::{material_angles, RodFrames};
-use crate::rod::integrate::{starting_at, symplectic_euler, Motion, Nodes};
-use crate::rod::substeps::{inextensibility_between_substeps, plan, Integration};
+use crate::rod::integrate::{symplectic_euler, Motion, Nodes};
+use crate::rod::substeps::{
+    inextensibility_between_substeps, plan, smallest_binormal_denominator, Integration,
+};
 use crate::rod::twist::ClampedFrames;
 use crate::rod::{implicit, twist, ClampedSegments, ElasticTerms};
 use crate::root_coupling::{carry_root_frame, held_velocity, root_coupling};
@@ -58,117 +58,95 @@ pub fn step_strand<M: Math, const N: usize>(
     if ctx.gates.frames {
         frames.insert(RodFrames::empty()).refresh(strand);
     }
-    let begun = begin(strand, ctx, grabs, index, frames.as_ref(), report);
-    // Lines 3–4: forces and integration, in substeps or one linearly implicit step.
-    let angles = integrate(strand, ctx, &begun, frames.as_mut(), accelerations, report);
-    finish(
+    let begun = begin(
         strand,
         ctx,
         grabs,
         index,
-        &begun,
-        frames.as_mut(),
-        &angles,
+        starting_from(frames.as_ref()),
         report,
     );
-}
-
-/// Steps `strands` (at most `W`; `W` strands of a block) by `ctx.dt`, as [`step_strand`] does
-/// each, with the same bits: the explicit substeps (lines 3–4, the bulk of a step) of all of
-/// them at once in lanes ([`explicit_substeps_in_lanes`]) when they take the same number of
-/// substeps and have as many nodes, and every other stage strand by strand. `first_strand` is
-/// the index of `strands[0]` in the scene; `accelerations`, if any, holds `N` per strand.
-pub fn step_block<M: Math, const N: usize, const W: usize>(
-    strands: &mut [Strand<N>],
-    ctx: &StepContext,
-    grabs: &[Grab],
-    first_strand: u32,
-    accelerations: Option<&[Vec3]>,
-    report: &mut StepReport,
-) {
-    let lanes = strands.len().min(W);
-    let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
-    let mut frames: Option<RodFrames<M, N>> = ctx.gates.frames.then(RodFrames::empty);
-    let mut begun: [Option<Begun<M, N>>; W] = [const { None }; W];
-    for (lane, strand) in strands.iter_mut().take(lanes).enumerate() {
-        if let Some(frames) = frames.as_mut() {
-            frames.refresh(strand);
-        }
-        let index = first_strand + lane as u32;
-        begun[lane] = Some(begin(strand, ctx, grabs, index, frames.as_ref(), report));
-    }
-    let mut angles = [[[1.0, 0.0]; N]; W];
-    match lanes_substeps(ctx, &strands[..lanes], &begun) {
-        Some(k) if lanes > 1 => {
-            let clamped = begun.each_ref().map(|b| b.as_ref().map(|b| b.clamped));
-            let clamped = clamped.map(|c| c.unwrap_or(ClampedSegments::ROOT_ONLY));
-            angles = explicit_substeps_in_lanes::<M, N, W>(
-                &mut strands[..lanes],
-                ctx,
-                &clamped,
-                k,
-                accelerations,
-                report,
-            );
-        }
-        _ => {
-            for (lane, strand) in strands.iter_mut().take(lanes).enumerate() {
-                let Some(begun) = begun[lane].as_ref() else {
-                    continue;
-                };
-                if let Some(frames) = frames.as_mut() {
-                    frames.refresh(strand);
-                }
-                angles[lane] =
-                    integrate(strand, ctx, begun, frames.as_mut(), of_strand(lane), report);
-            }
-        }
-    }
-    for (lane, strand) in strands.iter_mut().take(lanes).enumerate() {
-        let Some(begun) = begun[lane].as_ref() else {
-            continue;
-        };
-        let index = first_strand + lane as u32;
-        finish(
-            strand,
-            ctx,
-            grabs,
-            index,
-            begun,
-            frames.as_mut(),
-            &angles[lane],
-            report,
-        );
-    }
+    // Lines 3–4: forces and integration, in substeps or one linearly implicit step.
+    let angles = integrate(strand, ctx, &begun, frames.as_mut(), accelerations, report);
+    // Lines 5–11.
+    let frames = frames.as_mut();
+    finish(strand, ctx, grabs, index, &begun, frames, &angles, report);
 }
 
 /// What a strand's step decided and kept before its forces and integration.
-struct Begun<M: Math, const N: usize> {
+pub(super) struct Begun<M: Math, const N: usize> {
     /// Quarantine: the last good state.
     last_good: StrandState<N>,
     /// Sec. 7.2: the clamped segments C, the root's and each grabbed node's.
-    clamped: ClampedSegments,
+    pub(super) clamped: ClampedSegments,
     /// What the step keeps of the configuration it starts from.
     start: StepStart<M>,
     /// Lines 3–4 as substeps or the implicit step.
-    integration: Integration,
+    pub(super) integration: Integration,
+}
+
+/// What [`begin`] reads of the frames the step starts from (there when bending or twist is on):
+/// the sharpest fold, for the plan, and the clamped segments' frames, for the twist.
+pub(super) struct Starting<F, C> {
+    /// Whether the strand has frames (bending or twist on).
+    pub(super) has_frames: bool,
+    /// The frames' [`smallest_binormal_denominator`].
+    pub(super) smallest_denominator: F,
+    /// The clamped segments' frames (`ClampedFrames::save`), asked for only when a segment
+    /// other than the root is clamped.
+    pub(super) clamped_frames: C,
+}
+
+/// [`Starting`] from one strand's `frames`.
+#[allow(clippy::type_complexity)] // two closures over the same frames, named by what they give
+pub(super) fn starting_from<M: Math, const N: usize>(
+    frames: Option<&RodFrames<M, N>>,
+) -> Starting<
+    impl FnOnce(&Strand<N>) -> Real + '_,
+    impl FnOnce(&Strand<N>, &ClampedSegments) -> Option<ClampedFrames<M>> + '_,
+> {
+    Starting {
+        has_frames: frames.is_some(),
+        smallest_denominator: move |s: &Strand<N>| {
+            frames.map_or(2.0, |f| {
+                smallest_binormal_denominator(f, &s.rest.rod.rest_length)
+            })
+        },
+        clamped_frames: move |s: &Strand<N>, clamped: &ClampedSegments| {
+            frames.map(|f| ClampedFrames::save(f, &s.state.theta, clamped))
+        },
+    }
 }
 
 /// The start of a strand's step: the snapshot, the clamped set, what the step keeps of its
-/// starting configuration and its integration's plan. `frames`, there when bending or twist is
-/// on, are those of the strand's centreline.
-fn begin<M: Math, const N: usize>(
+/// starting configuration and its integration's plan, from what `starting` says of the
+/// strand's frames.
+pub(super) fn begin<M: Math, const N: usize, F, C>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     grabs: &[Grab],
     index: u32,
-    frames: Option<&RodFrames<M, N>>,
+    starting: Starting<F, C>,
     report: &mut StepReport,
-) -> Begun<M, N> {
+) -> Begun<M, N>
+where
+    F: FnOnce(&Strand<N>) -> Real,
+    C: FnOnce(&Strand<N>, &ClampedSegments) -> Option<ClampedFrames<M>>,
+{
     let last_good: StrandState<N> = snapshot(strand, report);
     let clamped = ClampedSegments::of_step(&ctx.gates, grabs, index, strand.rest.nodes);
-    let start = StepStart::capture(strand, &clamped, frames);
-    let integration = plan(ctx, &strand.rest.rod, &mut strand.schedule, frames);
+    let x = &strand.state.position;
+    let start = StepStart {
+        root_tangent: starting.has_frames.then(|| unit::<M>(x[1] - x[0])),
+        clamped_frames: match clamped.others().next() {
+            Some(_) if starting.has_frames => (starting.clamped_frames)(strand, &clamped),
+            _ => None,
+        },
+    };
+    let mut schedule = strand.schedule;
+    let smallest = || (starting.smallest_denominator)(strand);
+    let integration = plan(ctx, &strand.rest.rod, &mut schedule, smallest);
+    strand.schedule = schedule;
     Begun {
         last_good,
         clamped,
@@ -179,7 +157,7 @@ fn begin<M: Math, const N: usize>(
 
 /// Lines 3–4 on one strand: its explicit substeps or its implicit step. `frames` are those of
 /// the centreline the step starts from.
-fn integrate<M: Math, const N: usize>(
+pub(super) fn integrate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     begun: &Begun<M, N>,
@@ -203,7 +181,7 @@ fn integrate<M: Math, const N: usize>(
 /// frame in time, the projection, the Bishop frame in space and the twist, the guard.
 /// `angles` are the `(cos θ^j, sin θ^j)` the forces used; `frames` a buffer for the frames.
 #[allow(clippy::too_many_arguments)] // the step's inputs, its strand, and what it began with
-fn finish<M: Math, const N: usize>(
+pub(super) fn finish<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     grabs: &[Grab],
@@ -235,28 +213,6 @@ fn finish<M: Math, const N: usize>(
     if guard(strand, &begun.last_good, verdict, index, report) {
         strand.schedule.implicit_bending = true;
     }
-}
-
-/// The substep count `k` that every strand of a block takes in lanes, or `None` when they
-/// differ in it, in their node count, or in needing anything the lanes do not do (the
-/// implicit step, frames off, projections between substeps): those strands step one by one.
-fn lanes_substeps<M: Math, const N: usize, const W: usize>(
-    ctx: &StepContext,
-    strands: &[Strand<N>],
-    begun: &[Option<Begun<M, N>>; W],
-) -> Option<u32> {
-    let nodes = strands.first()?.rest.nodes;
-    let k = match begun.first()?.as_ref()?.integration {
-        Integration::Explicit(k) => k,
-        Integration::Implicit => return None,
-    };
-    let same = strands.iter().zip(begun).all(|(strand, begun)| {
-        let plan = begun.as_ref().map(|b| b.integration);
-        strand.rest.nodes == nodes && plan == Some(Integration::Explicit(k))
-    });
-    let h = ctx.dt / k as Real;
-    let plain = ctx.gates.frames && inextensibility_between_substeps(ctx, k, h).is_none();
-    (same && plain).then_some(k)
 }
 
 /// Lines 3–4 as `k` substeps of `h = dt/k` (`rod::substeps`): each the elastic forces of
@@ -306,7 +262,15 @@ fn explicit_substeps<M: Math, const N: usize>(
             velocity: &mut strand.state.velocity,
             inverse_mass: &strand.rest.inverse_mass,
         };
-        symplectic_euler(nodes, &external, &forces, h, accelerations, &mut motion);
+        symplectic_euler(
+            nodes,
+            &external,
+            &forces,
+            h,
+            accelerations,
+            &mut motion,
+            true,
+        );
         if let (Some(sub), true) = (&between, substep + 1 < k) {
             // Segment lengths between substeps; the step's own projection follows the last.
             let mut scratch = StepReport::default();
@@ -315,62 +279,6 @@ fn explicit_substeps<M: Math, const N: usize>(
         }
     }
     cos_sin
-}
-
-/// [`explicit_substeps`] of up to `W` strands at once, one per lane (`lane::Lanes`): the same
-/// kernels — frame pass, elastic forces, symplectic Euler — on the strands' values gathered
-/// into lanes, so each strand gets the bits [`explicit_substeps`] gives it (a lane past the
-/// block's strands repeats the last strand and is dropped). For strands with frames, the same
-/// `k` and node count, and no projection between substeps ([`lanes_substeps`]).
-fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
-    strands: &mut [Strand<N>],
-    ctx: &StepContext,
-    clamped: &[ClampedSegments; W],
-    k: u32,
-    accelerations: Option<&[Vec3]>,
-    report: &mut StepReport,
-) -> [[[Real; 2]; N]; W] {
-    let lanes = strands.len().min(W) as u32;
-    report.ran_on(Stage::ElasticForces, lanes);
-    report.ran_on(Stage::ExternalForces, lanes);
-    report.ran_on(Stage::Integrate, lanes);
-    let mut block = LaneBlock::<N, W>::gather::<M>(strands, accelerations);
-    let h = Wide::splat(ctx.dt / k as Real);
-    let terms = ElasticTerms::of(&ctx.gates);
-    let external = External::<Lanes<M, W>> {
-        gravity_and_wind: V3::splat(ctx.gravity + ctx.wind),
-        drag: Wide::splat(drag(ctx)),
-    };
-    let mut frames = RodFrames::<Lanes<M, W>, N>::empty();
-    let mut forces = [V3::<Wide<W>>::zero(); N];
-    let mut motion = starting_at::<Lanes<M, W>, N>(block.position);
-    let nodes = block.nodes;
-    for _ in 0..k {
-        frames.recompute(
-            &block.position[..nodes],
-            block.root_frame,
-            &block.rest.rest_length,
-        );
-        let (theta, rest) = (&block.theta, &block.rest);
-        elastic_forces_with_angles(
-            &frames,
-            theta,
-            &block.cos_sin,
-            rest,
-            clamped,
-            terms,
-            &mut forces,
-        );
-        let lane_nodes = Nodes::<Lanes<M, W>, N> {
-            count: nodes,
-            position: &mut block.position,
-            velocity: &mut block.velocity,
-            inverse_mass: &block.inverse_mass,
-        };
-        let acc = block.accelerations.as_ref().map(|a| &a[..]);
-        symplectic_euler(lane_nodes, &external, &forces, h, acc, &mut motion);
-    }
-    block.scatter(strands)
 }
 
 /// Lines 3–4 as one linearly implicit bending step of `dt` (`rod::implicit`): the elastic
@@ -407,35 +315,7 @@ fn implicit_bending<M: Math, const N: usize>(
 /// What the step keeps of the configuration it starts from: the root tangent (for the
 /// time-parallel transport of `u^0`) and the clamped segments' material frames (for the
 /// twist), both there when bending or twist is on.
-struct StepStart<M: Math> {
+pub(super) struct StepStart<M: Math> {
     root_tangent: Option<Vec3>,
     clamped_frames: Option<ClampedFrames<M>>,
 }
-
-impl<M: Math> StepStart<M> {
-    /// `frames` are those of the strand's centreline, there when bending or twist is on.
-    fn capture<const N: usize>(
-        strand: &Strand<N>,
-        clamped: &ClampedSegments,
-        frames: Option<&RodFrames<M, N>>,
-    ) -> Self {
-        let Some(frames) = frames else {
-            return StepStart {
-                root_tangent: None,
-                clamped_frames: None,
-            };
-        };
-        let x = &strand.state.position;
-        let clamped_frames = clamped
-            .others()
-            .next()
-            .map(|_| ClampedFrames::save(frames, &strand.state.theta, clamped));
-        StepStart {
-            root_tangent: Some(unit::<M>(x[1] - x[0])),
-            clamped_frames,
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests;

@@ -11,8 +11,6 @@ use crate::strand::{RodRest, Strand};
 
 /// The lanes of a block: state, rest data and the step's per-node inputs, one strand per lane.
 pub struct LaneBlock<const N: usize, const W: usize> {
-    /// Strands in the block (`≤ W`; the lanes past them repeat the last strand).
-    pub strands: usize,
     /// Nodes per strand (the same in every lane).
     pub nodes: usize,
     /// `x`.
@@ -33,112 +31,119 @@ pub struct LaneBlock<const N: usize, const W: usize> {
     pub accelerations: Option<[V3<Wide<W>>; N]>,
 }
 
-/// `[f(strand 0), …, f(strand W−1)]` as lanes, the last strand repeated past the block's.
-#[inline(always)]
-fn lanes_of<const N: usize, const W: usize>(
-    strands: &[Strand<N>],
-    f: impl Fn(&Strand<N>) -> Real,
-) -> Wide<W> {
-    let last = strands.len().saturating_sub(1);
-    Wide(core::array::from_fn(|l| f(&strands[l.min(last)])))
-}
-
-/// As [`lanes_of`] for a vector.
-#[inline(always)]
-fn vectors_of<const N: usize, const W: usize>(
-    strands: &[Strand<N>],
-    f: impl Fn(&Strand<N>) -> Vec3,
-) -> V3<Wide<W>> {
-    V3 {
-        x: lanes_of(strands, |s| f(s).x),
-        y: lanes_of(strands, |s| f(s).y),
-        z: lanes_of(strands, |s| f(s).z),
-    }
-}
-
 impl<const N: usize, const W: usize> LaneBlock<N, W> {
-    /// `strands` (1 to `W` of them, with the same node count) in lanes, with their
-    /// `accelerations` (`N` per strand) if any.
+    /// The strands of `strands` (at most `W`) that `gathered` names, in their lanes, with
+    /// their `accelerations` (`N` per strand of `strands`) if any. They have the same node
+    /// count; at least one is named. A lane left out holds a copy of a strand that is in, so
+    /// that it computes nothing out of range; it is never scattered back.
     #[must_use]
-    pub fn gather<M: Math>(strands: &[Strand<N>], accelerations: Option<&[Vec3]>) -> Self {
-        let nodes = strands.first().map_or(0, |s| s.rest.nodes.min(N));
-        let segments = nodes.saturating_sub(1);
-        let at = |i: usize| {
-            let position = vectors_of(strands, |s| s.state.position[i]);
-            let velocity = vectors_of(strands, |s| s.state.velocity[i]);
-            (position, velocity)
+    pub fn gather<M: Math>(
+        strands: &[Strand<N>],
+        gathered: &[bool; W],
+        accelerations: Option<&[Vec3]>,
+    ) -> Self {
+        let any = gathered.iter().position(|&g| g).unwrap_or(0);
+        let nodes = strands.get(any).map_or(0, |s| s.rest.nodes.min(N));
+        let zero = Wide::splat(0.0);
+        let mut block = LaneBlock {
+            nodes,
+            position: [V3::zero(); N],
+            velocity: [V3::zero(); N],
+            theta: [zero; N],
+            cos_sin: [[Wide::splat(1.0), zero]; N],
+            root_frame: V3::zero(),
+            inverse_mass: [zero; N],
+            rest: RodRest {
+                rest_length: [zero; N],
+                voronoi_length: [zero; N],
+                inverse_voronoi_length: [zero; N],
+                bending_stiffness: [zero; N],
+                minor_axis_penalty: zero,
+                twist_stiffness: zero,
+                rest_theta: [zero; N],
+                rest_twist: [zero; N],
+                rest_twist_rotation: [[zero; 2]; N],
+                rest_curvature: [[[zero; 2]; 2]; N],
+                stable_time_step: zero,
+            },
+            accelerations: accelerations.map(|_| [V3::zero(); N]),
         };
-        let states: [(V3<Wide<W>>, V3<Wide<W>>); N] = core::array::from_fn(at);
-        // The material angles' sines and cosines strand by strand, as `material_angles`.
-        let mut cos_sin = [[Wide::splat(1.0), Wide::splat(0.0)]; N];
-        let last = strands.len().saturating_sub(1);
-        for lane in 0..W {
-            let strand = &strands[lane.min(last)];
-            let angles = material_angles::<M, N>(&strand.state.theta[..segments]);
-            for (slot, [c, s]) in cos_sin.iter_mut().zip(angles) {
-                slot[0].0[lane] = c;
-                slot[1].0[lane] = s;
+        for (lane, &is_in) in gathered.iter().enumerate() {
+            let source = if is_in { lane } else { any };
+            if let Some(strand) = strands.get(source) {
+                let extra = accelerations.and_then(|a| a.get(source * N..(source + 1) * N));
+                block.put::<M>(lane, strand, extra);
             }
         }
-        let accelerations = accelerations.map(|a| {
-            core::array::from_fn(|i| {
-                let per_lane = |l: usize| a.get(l.min(last) * N + i).copied().unwrap_or(Vec3::ZERO);
-                V3 {
-                    x: Wide(core::array::from_fn(|l| per_lane(l).x)),
-                    y: Wide(core::array::from_fn(|l| per_lane(l).y)),
-                    z: Wide(core::array::from_fn(|l| per_lane(l).z)),
-                }
-            })
-        });
-        LaneBlock {
-            strands: strands.len().min(W),
-            nodes,
-            position: states.map(|s| s.0),
-            velocity: states.map(|s| s.1),
-            theta: core::array::from_fn(|j| lanes_of(strands, |s| s.state.theta[j])),
-            cos_sin,
-            root_frame: vectors_of(strands, |s| s.state.root_frame),
-            inverse_mass: core::array::from_fn(|i| lanes_of(strands, |s| s.rest.inverse_mass[i])),
-            rest: gather_rest(strands),
-            accelerations,
-        }
+        block
     }
 
-    /// Writes the free nodes' positions and velocities back into `strands` and returns each
-    /// strand's `(cos θ^j, sin θ^j)`.
-    pub fn scatter(&self, strands: &mut [Strand<N>]) -> [[[Real; 2]; N]; W] {
-        for (lane, strand) in strands.iter_mut().take(self.strands).enumerate() {
+    /// Writes `strand` (and its accelerations `extra`, if any) into lane `lane`.
+    fn put<M: Math>(&mut self, lane: usize, strand: &Strand<N>, extra: Option<&[Vec3]>) {
+        let (state, rest) = (&strand.state, &strand.rest);
+        let nodes = self.nodes;
+        for i in 0..nodes {
+            self.position[i].set_lane(lane, state.position[i]);
+            self.velocity[i].set_lane(lane, state.velocity[i]);
+            self.inverse_mass[i].0[lane] = rest.inverse_mass[i];
+        }
+        if let (Some(lanes), Some(extra)) = (self.accelerations.as_mut(), extra) {
+            for (slot, a) in lanes.iter_mut().zip(extra).take(nodes) {
+                slot.set_lane(lane, *a);
+            }
+        }
+        self.root_frame.set_lane(lane, state.root_frame);
+        // The material angles' sines and cosines, as `material_angles` computes them.
+        let segments = nodes.saturating_sub(1);
+        let angles = material_angles::<M, N>(&state.theta[..segments]);
+        for (j, [c, s]) in angles.into_iter().enumerate() {
+            self.theta[j].0[lane] = state.theta[j];
+            self.cos_sin[j][0].0[lane] = c;
+            self.cos_sin[j][1].0[lane] = s;
+        }
+        self.put_rest(lane, &rest.rod);
+    }
+
+    /// Writes the rod rest data `rod` into lane `lane`.
+    fn put_rest(&mut self, lane: usize, rod: &RodRest<N>) {
+        let r = &mut self.rest;
+        for i in 0..self.nodes {
+            r.rest_length[i].0[lane] = rod.rest_length[i];
+            r.voronoi_length[i].0[lane] = rod.voronoi_length[i];
+            r.inverse_voronoi_length[i].0[lane] = rod.inverse_voronoi_length[i];
+            r.bending_stiffness[i].0[lane] = rod.bending_stiffness[i];
+            r.rest_theta[i].0[lane] = rod.rest_theta[i];
+            r.rest_twist[i].0[lane] = rod.rest_twist[i];
+            for k in 0..2 {
+                r.rest_twist_rotation[i][k].0[lane] = rod.rest_twist_rotation[i][k];
+                for c in 0..2 {
+                    r.rest_curvature[i][k][c].0[lane] = rod.rest_curvature[i][k][c];
+                }
+            }
+        }
+        r.minor_axis_penalty.0[lane] = rod.minor_axis_penalty;
+        r.twist_stiffness.0[lane] = rod.twist_stiffness;
+        r.stable_time_step.0[lane] = rod.stable_time_step;
+    }
+
+    /// Writes the free nodes' positions and velocities of the lanes that took substeps
+    /// (`substeps[l] > 0`) back into `strands`, and their `(cos θ^j, sin θ^j)` into `angles`.
+    pub fn scatter(
+        &self,
+        strands: &mut [Strand<N>],
+        substeps: &[u32; W],
+        angles: &mut [[[Real; 2]; N]; W],
+    ) {
+        let lanes = strands.iter_mut().zip(angles.iter_mut()).enumerate();
+        for (lane, (strand, angles)) in lanes.take(W) {
+            if substeps[lane] == 0 {
+                continue;
+            }
             for i in 2..self.nodes.min(N) {
                 strand.state.position[i] = self.position[i].lane(lane);
                 strand.state.velocity[i] = self.velocity[i].lane(lane);
             }
+            *angles = self.cos_sin.map(|[c, s]| [c.0[lane], s.0[lane]]);
         }
-        core::array::from_fn(|lane| self.cos_sin.map(|[c, s]| [c.0[lane], s.0[lane]]))
-    }
-}
-
-/// The rod rest data of `strands` in lanes.
-fn gather_rest<const N: usize, const W: usize>(strands: &[Strand<N>]) -> RodRest<N, Wide<W>> {
-    let per_node = |f: fn(&RodRest<N>, usize) -> Real| -> [Wide<W>; N] {
-        core::array::from_fn(|i| lanes_of(strands, |s| f(&s.rest.rod, i)))
-    };
-    let pair = |f: fn(&RodRest<N>, usize, usize) -> Real| -> [[Wide<W>; 2]; N] {
-        core::array::from_fn(|i| [0, 1].map(|k| lanes_of(strands, |s| f(&s.rest.rod, i, k))))
-    };
-    RodRest {
-        rest_length: per_node(|r, i| r.rest_length[i]),
-        voronoi_length: per_node(|r, i| r.voronoi_length[i]),
-        inverse_voronoi_length: per_node(|r, i| r.inverse_voronoi_length[i]),
-        bending_stiffness: per_node(|r, i| r.bending_stiffness[i]),
-        minor_axis_penalty: lanes_of(strands, |s| s.rest.rod.minor_axis_penalty),
-        twist_stiffness: lanes_of(strands, |s| s.rest.rod.twist_stiffness),
-        rest_theta: per_node(|r, i| r.rest_theta[i]),
-        rest_twist: per_node(|r, i| r.rest_twist[i]),
-        rest_twist_rotation: pair(|r, i, k| r.rest_twist_rotation[i][k]),
-        rest_curvature: core::array::from_fn(|i| {
-            [0, 1]
-                .map(|k| [0, 1].map(|c| lanes_of(strands, |s| s.rest.rod.rest_curvature[i][k][c])))
-        }),
-        stable_time_step: lanes_of(strands, |s| s.rest.rod.stable_time_step),
     }
 }

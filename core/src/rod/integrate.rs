@@ -6,7 +6,7 @@
 
 use crate::forces::External;
 use crate::math::Vec3;
-use crate::precision::{Kernel, Vector};
+use crate::precision::{Arithmetic, Kernel, Vector};
 use crate::strand::Strand;
 
 /// Where the substeps so far moved a strand's nodes: positions are the step's start plus a
@@ -61,7 +61,9 @@ pub struct Nodes<'a, P: Kernel, const N: usize> {
 /// Symplectic Euler over `h` with the elastic forces `forces` and the external forces
 /// `F = M g − ν ẋ` plus the caller's accelerations: `v ← v + h F/m`, then `x ← x + h v`
 /// (Kmoch 2009 Sec. 7, Alg. 1 line 4), with `x = x_start + Σ v h` over the substeps so far
-/// ([`Motion`]). Nodes 0 and 1 belong to the head.
+/// ([`Motion`]). Nodes 0 and 1 belong to the head. Lanes outside `active` keep their velocities
+/// and displacements (a strand in a block that has taken all its substeps): `true` for one
+/// strand.
 pub fn symplectic_euler<P: Kernel, const N: usize>(
     nodes: Nodes<'_, P, N>,
     external: &External<P>,
@@ -69,6 +71,7 @@ pub fn symplectic_euler<P: Kernel, const N: usize>(
     h: P::R,
     accelerations: Option<&[P::V]>,
     motion: &mut Motion<N, P::V>,
+    active: <P::R as Arithmetic>::Mask,
 ) {
     let n = nodes.count.min(N);
     let Motion {
@@ -81,8 +84,9 @@ pub fn symplectic_euler<P: Kernel, const N: usize>(
         let velocity = nodes.velocity[i];
         let a = external.acceleration(forces[i], velocity, nodes.inverse_mass[i], accelerations, i);
         let v = velocity + a * h;
-        nodes.velocity[i] = v;
-        displacement[i] += v * h;
+        let moved = displacement[i] + v * h;
+        nodes.velocity[i] = P::V::select(active, v, velocity);
+        displacement[i] = P::V::select(active, moved, displacement[i]);
         nodes.position[i] = start[i] + displacement[i];
     }
 }

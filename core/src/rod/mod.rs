@@ -125,6 +125,10 @@ impl<R: Scalar> ClampedLanes<R> for ClampedSegments {
 impl<const W: usize> ClampedLanes<Wide<W>> for [ClampedSegments; W] {
     #[inline(always)]
     fn clamped(&self, segment: usize) -> WideMask<W> {
+        // Most blocks hold no grab: no lane's set to search.
+        if self.iter().all(|set| set.count == 0) {
+            return WideMask([segment == 0; W]);
+        }
         WideMask(core::array::from_fn(|lane| self[lane].contains(segment)))
     }
 }

@@ -68,6 +68,7 @@ use super::frames::RodFrames;
 use crate::context::{Gates, StepContext};
 use crate::effects::{Effect, Effects};
 use crate::error::ParamError;
+use crate::lane::{Lanes, Wide};
 use crate::math::{Math, Real};
 use crate::params::{Mode, Params, Solver};
 use crate::strand::{RodRest, Schedule, Strand};
@@ -115,7 +116,8 @@ impl Integration {
 }
 
 /// The policy for one step of a strand with rest data `rest` and schedule `schedule`, whose
-/// frames (there when bending or twist is on) are `frames`: the implicit step when the strand
+/// frames' [`smallest_binormal_denominator`] `smallest` gives (asked for only with bending
+/// on, when the strand has frames): the implicit step when the strand
 /// needs [`IMPLICIT_FROM`] or more fixed substeps, or its schedule says so; else, when its
 /// shape is folded sharper than substeps can hold (≥ 137° for human hair at 1 cm and 1 ms),
 /// the implicit step from now on (the schedule remembers: one switch per strand, so the cost
@@ -123,23 +125,23 @@ impl Integration {
 /// data and the allowance in fixed-cost mode ([`substeps`]), from the shape the step starts
 /// from with a margin for the fold to tighten within the step in converge mode
 /// ([`substeps_within_step`]). Without bending, one substep.
-pub fn plan<M: Math, const N: usize>(
+pub fn plan<const N: usize>(
     ctx: &StepContext,
     rest: &RodRest<N>,
     schedule: &mut Schedule,
-    frames: Option<&RodFrames<M, N>>,
+    smallest: impl FnOnce() -> Real,
 ) -> Integration {
     let bending = ctx.gates.bending;
     let fixed = substeps(rest, ctx.dt, bending);
     // (Bending on means frames.)
-    let Some(frames) = frames.filter(|_| bending) else {
+    if !bending {
         return Integration::Explicit(fixed);
-    };
+    }
     if fixed >= IMPLICIT_FROM || schedule.implicit_bending {
         return Integration::Implicit;
     }
     // The sharpest fold's `1 + cos φ` (2 when straight), in the shape the step starts from.
-    let smallest = smallest_binormal_denominator(frames, &rest.rest_length);
+    let smallest = smallest();
     if substeps_for_shape(rest, ctx.dt, true, smallest) >= IMPLICIT_FROM {
         schedule.implicit_bending = true;
         return Integration::Implicit;
@@ -184,11 +186,32 @@ pub fn smallest_binormal_denominator<M: Math, const N: usize>(
     frames: &RodFrames<M, N>,
     rest_length: &[Real; N],
 ) -> Real {
+    let n = frames.interior();
+    smallest_relative_denominator::<N>(n, |i| frames.denominator[i], |i| rest_length[i])
+}
+
+/// [`smallest_binormal_denominator`] of lane `lane` of the frames of `W` strands in lanes.
+#[must_use]
+pub fn smallest_binormal_denominator_in_lane<M: Math, const N: usize, const W: usize>(
+    frames: &RodFrames<Lanes<M, W>, N>,
+    rest_length: &[Wide<W>; N],
+    lane: usize,
+) -> Real {
+    let n = frames.interior();
+    let denominator = |i: usize| frames.denominator[i].0[lane];
+    smallest_relative_denominator::<N>(n, denominator, |i| rest_length[i].0[lane])
+}
+
+/// `min d_i / (|ê^{i−1}||ê^i|)` over nodes `1 ..= n` (NaN when any is NaN), 2 when none.
+fn smallest_relative_denominator<const N: usize>(
+    n: usize,
+    denominator: impl Fn(usize) -> Real,
+    rest_length: impl Fn(usize) -> Real,
+) -> Real {
     let mut smallest: Real = 2.0;
-    let n = frames.interior().min(N.saturating_sub(1));
-    for i in 1..=n {
-        let scale = rest_length[i - 1] * rest_length[i];
-        let relative = frames.denominator[i] / scale;
+    for i in 1..=n.min(N.saturating_sub(1)) {
+        let scale = rest_length(i - 1) * rest_length(i);
+        let relative = denominator(i) / scale;
         // A NaN counts as a fold (the guard rolls the strand back after the step).
         if relative < smallest || relative.is_nan() {
             smallest = relative;

@@ -1,0 +1,255 @@
+//! The rod's pipeline on a block of `W` strands (Kmoch 2009 Algorithm 1, as
+//! [`super::rod::step_strand`] on each): the explicit substeps of lines 3–4, the bulk of a
+//! step, run for the block's strands at once, one per lane (`lane::Lanes`), through the very
+//! kernels a strand runs alone — so every strand gets the bits it gets alone; the other stages
+//! run strand by strand. Strands that differ in their substep count are masked once they have
+//! taken theirs; a strand that takes the implicit step, projects between substeps, or has
+//! another node count than the block's steps alone.
+
+use crate::context::StepContext;
+use crate::forces::{drag, External};
+use crate::grab::Grab;
+use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
+use crate::math::{Math, Real, Vec3};
+use crate::report::{Stage, StepReport};
+use crate::rod::block::LaneBlock;
+use crate::rod::energy::elastic_forces_with_angles;
+use crate::rod::frames::RodFrames;
+use crate::rod::integrate::{starting_at, symplectic_euler, Nodes};
+use crate::rod::substeps::{
+    inextensibility_between_substeps, smallest_binormal_denominator_in_lane, Integration,
+};
+use crate::rod::twist::ClampedFrames;
+use crate::rod::{ClampedSegments, ElasticTerms};
+use crate::strand::Strand;
+
+use super::rod::{begin, finish, integrate, starting_from, Begun, Starting};
+
+/// Steps `strands` (at most `W`) by `ctx.dt`, as [`super::rod::step_strand`] steps each, with
+/// the same bits. `first_strand` is the index of `strands[0]` in the scene; `accelerations`,
+/// if any, holds `N` per strand.
+pub fn step_block<M: Math, const N: usize, const W: usize>(
+    strands: &mut [Strand<N>],
+    ctx: &StepContext,
+    grabs: &[Grab],
+    first_strand: u32,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    let count = strands.len().min(W);
+    let strands = &mut strands[..count];
+    // Sec. 5: the lanes' frames of the configuration the step starts from.
+    let mut step = BlockStep::<M, N, W>::gather(strands, ctx, accelerations);
+    // Snapshot, clamped set, what the step keeps, the plan: strand by strand.
+    step.begin(strands, ctx, grabs, first_strand, report);
+    // Lines 3–4: in lanes, or alone.
+    step.integrate(strands, ctx, accelerations, report);
+    // Lines 5–11, strand by strand.
+    step.finish(strands, ctx, grabs, first_strand, report);
+}
+
+/// A block's step in the making: its lanes, their frames, and each strand's start.
+struct BlockStep<M: Math, const N: usize, const W: usize> {
+    /// Which strands are in the lanes: those with the first one's node count, when strands
+    /// have frames (bending or twist on).
+    gathered: [bool; W],
+    /// The lanes, when two strands or more are in them.
+    block: Option<LaneBlock<N, W>>,
+    /// The lanes' frames of the configuration the step starts from.
+    lane_frames: RodFrames<Lanes<M, W>, N>,
+    /// One strand's frames, for the strands that step alone and for the twist.
+    frames: Option<RodFrames<M, N>>,
+    /// Each strand's start.
+    begun: [Option<Begun<M, N>>; W],
+    /// The substeps each lane takes in the block (0: the strand steps alone).
+    substeps: [u32; W],
+    /// `(cos θ^j, sin θ^j)` each strand's forces used.
+    angles: [[[Real; 2]; N]; W],
+}
+
+impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
+    /// The lanes of `strands` and their frames.
+    fn gather(strands: &[Strand<N>], ctx: &StepContext, accelerations: Option<&[Vec3]>) -> Self {
+        let nodes = strands.first().map_or(0, |s| s.rest.nodes);
+        let gathered: [bool; W] = core::array::from_fn(|l| {
+            ctx.gates.frames && strands.get(l).is_some_and(|s| s.rest.nodes == nodes)
+        });
+        let block = (gathered.iter().filter(|&&g| g).count() > 1)
+            .then(|| LaneBlock::<N, W>::gather::<M>(strands, &gathered, accelerations));
+        let mut lane_frames = RodFrames::<Lanes<M, W>, N>::empty();
+        if let Some(block) = &block {
+            let (position, rest_length) = (&block.position[..block.nodes], &block.rest.rest_length);
+            lane_frames.recompute(position, block.root_frame, rest_length);
+        }
+        BlockStep {
+            gathered,
+            block,
+            lane_frames,
+            frames: ctx.gates.frames.then(RodFrames::empty),
+            begun: [const { None }; W],
+            substeps: [0; W],
+            angles: [[[1.0, 0.0]; N]; W],
+        }
+    }
+
+    /// Each strand's start (`super::rod::begin`): the plan from its lane's frames, or from
+    /// frames of its own; then the substeps each lane takes in the block.
+    fn begin(
+        &mut self,
+        strands: &mut [Strand<N>],
+        ctx: &StepContext,
+        grabs: &[Grab],
+        first_strand: u32,
+        report: &mut StepReport,
+    ) {
+        for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+            let index = first_strand + lane as u32;
+            let started = match (&self.block, self.frames.as_mut()) {
+                (Some(block), Some(scratch)) if self.gathered[lane] => {
+                    let (frames, rest_length) = (&self.lane_frames, &block.rest.rest_length);
+                    let starting = Starting {
+                        has_frames: true,
+                        smallest_denominator: |_: &Strand<N>| {
+                            smallest_binormal_denominator_in_lane(frames, rest_length, lane)
+                        },
+                        clamped_frames: |s: &Strand<N>, clamped: &ClampedSegments| {
+                            scratch.refresh(s);
+                            Some(ClampedFrames::save(scratch, &s.state.theta, clamped))
+                        },
+                    };
+                    begin(strand, ctx, grabs, index, starting, report)
+                }
+                (_, frames) => {
+                    let frames = frames.map(|f| {
+                        f.refresh(strand);
+                        &*f
+                    });
+                    begin(strand, ctx, grabs, index, starting_from(frames), report)
+                }
+            };
+            self.begun[lane] = Some(started);
+        }
+        self.substeps = core::array::from_fn(|lane| match &self.begun[lane] {
+            Some(b) if self.gathered[lane] => match b.integration {
+                Integration::Explicit(k) if plain(ctx, k) => k,
+                _ => 0,
+            },
+            _ => 0,
+        });
+        if self.substeps.iter().filter(|&&k| k > 0).count() < 2 {
+            self.substeps = [0; W];
+        }
+    }
+
+    /// Lines 3–4: the lanes' substeps, then each strand that steps alone.
+    fn integrate(
+        &mut self,
+        strands: &mut [Strand<N>],
+        ctx: &StepContext,
+        accelerations: Option<&[Vec3]>,
+        report: &mut StepReport,
+    ) {
+        if let (Some(block), true) = (self.block.as_mut(), self.substeps.iter().any(|&k| k > 0)) {
+            let clamped = self
+                .begun
+                .each_ref()
+                .map(|b| b.as_ref().map_or_else(Default::default, |b| b.clamped));
+            let (frames, substeps) = (&mut self.lane_frames, &self.substeps);
+            explicit_substeps_in_lanes(block, frames, ctx, &clamped, substeps, report);
+            block.scatter(strands, substeps, &mut self.angles);
+        }
+        let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
+        for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+            let alone = self.substeps[lane] == 0;
+            let Some(begun) = self.begun[lane].as_ref().filter(|_| alone) else {
+                continue;
+            };
+            if let Some(frames) = self.frames.as_mut() {
+                frames.refresh(strand);
+            }
+            let (frames, acc) = (self.frames.as_mut(), of_strand(lane));
+            self.angles[lane] = integrate(strand, ctx, begun, frames, acc, report);
+        }
+    }
+
+    /// Lines 5–11 (`super::rod::finish`), strand by strand.
+    fn finish(
+        &mut self,
+        strands: &mut [Strand<N>],
+        ctx: &StepContext,
+        grabs: &[Grab],
+        first_strand: u32,
+        report: &mut StepReport,
+    ) {
+        for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+            if let Some(begun) = self.begun[lane].as_ref() {
+                let (index, angles) = (first_strand + lane as u32, &self.angles[lane]);
+                finish(
+                    strand,
+                    ctx,
+                    grabs,
+                    index,
+                    begun,
+                    self.frames.as_mut(),
+                    angles,
+                    report,
+                );
+            }
+        }
+    }
+}
+
+/// Whether `k` substeps run without a projection between them (what the lanes do).
+fn plain(ctx: &StepContext, k: u32) -> bool {
+    inextensibility_between_substeps(ctx, k, ctx.dt / k as Real).is_none()
+}
+
+/// `super::rod::explicit_substeps` of the lanes of `block`, lane `l` taking `substeps[l]` of
+/// `dt / substeps[l]` (none for 0) and keeping still once it has taken them: the same kernels
+/// — frame pass, elastic forces, symplectic Euler — on each lane's values, so each strand gets
+/// the bits it gets alone. `frames` come in as those of the configuration the step starts
+/// from and are recomputed in place for each later substep.
+fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
+    block: &mut LaneBlock<N, W>,
+    frames: &mut RodFrames<Lanes<M, W>, N>,
+    ctx: &StepContext,
+    clamped: &[ClampedSegments; W],
+    substeps: &[u32; W],
+    report: &mut StepReport,
+) {
+    let lanes = substeps.iter().filter(|&&k| k > 0).count() as u32;
+    report.ran_on(Stage::ElasticForces, lanes);
+    report.ran_on(Stage::ExternalForces, lanes);
+    report.ran_on(Stage::Integrate, lanes);
+    let most = substeps.iter().copied().max().unwrap_or(0);
+    let h = Wide(substeps.map(|k| ctx.dt / k.max(1) as Real));
+    let terms = ElasticTerms::of(&ctx.gates);
+    let external = External::<Lanes<M, W>> {
+        gravity_and_wind: V3::splat(ctx.gravity + ctx.wind),
+        drag: Wide::splat(drag(ctx)),
+    };
+    let mut forces = [V3::<Wide<W>>::zero(); N];
+    let mut motion = starting_at::<Lanes<M, W>, N>(block.position);
+    let nodes = block.nodes;
+    for substep in 0..most {
+        // The first substep starts where the frames were computed.
+        if substep > 0 {
+            frames.recompute(
+                &block.position[..nodes],
+                block.root_frame,
+                &block.rest.rest_length,
+            );
+        }
+        let (theta, rest, cos_sin) = (&block.theta, &block.rest, &block.cos_sin);
+        elastic_forces_with_angles(frames, theta, cos_sin, rest, clamped, terms, &mut forces);
+        let lane_nodes = Nodes::<Lanes<M, W>, N> {
+            count: nodes,
+            position: &mut block.position,
+            velocity: &mut block.velocity,
+            inverse_mass: &block.inverse_mass,
+        };
+        let active = WideMask(substeps.map(|k| substep < k));
+        let acc = block.accelerations.as_ref().map(|a| &a[..]);
+        symplectic_euler(lane_nodes, &external, &forces, h, acc, &mut motion, active);
+    }
+}
