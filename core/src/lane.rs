@@ -188,12 +188,20 @@ impl<const W: usize> Arithmetic for Wide<W> {
         <Self as Lane>::lt(self, other)
     }
     #[inline(always)]
+    fn between(self, low: Self, high: Self) -> WideMask<W> {
+        <Self as Lane>::lt(low, self) & <Self as Lane>::lt(self, high)
+    }
+    #[inline(always)]
     fn select(mask: WideMask<W>, a: Self, b: Self) -> Self {
         <Self as Lane>::select(mask, a, b)
     }
     #[inline(always)]
     fn any(mask: WideMask<W>) -> bool {
         <Self as Lane>::any(mask)
+    }
+    #[inline(always)]
+    fn all(mask: WideMask<W>) -> bool {
+        <Self as Lane>::all(mask)
     }
 }
 
