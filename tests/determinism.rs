@@ -35,7 +35,9 @@ fn glam_math_goes_through_libm() {
 /// per-strand path, bit for bit, every step of 1,500: in fixed-cost mode, where every lane of
 /// a block takes the same 4 substeps and the lanes run them, and in converge mode on blocks
 /// whose strands differ in their substep count, in the implicit switch (a stiff strand), in
-/// their projection iterations, and in a roll-back (a NaN put into one strand's velocity).
+/// their projection iterations, and in a roll-back (a NaN put into one strand's velocity); a
+/// grab holds a node of one strand throughout (its clamped segment steps that strand's twist
+/// alone). The twist is the hair-optimised one (the default), in lanes.
 /// Each of those cases is counted and must have occurred.
 mod rod_blocks {
     use hairsim_core::collide::{Collider, Shape};
@@ -44,8 +46,8 @@ mod rod_blocks {
     use hairsim_core::rod::frames::RodFrames;
     use hairsim_core::rod::substeps::{plan, smallest_binormal_denominator, Integration};
     use hairsim_core::{
-        step_strands, step_strands_in_lanes, Effect, Effects, Libm, Material, Math, Mode, Params,
-        Pose, Real, Shake, StepReport, Strand, Vec3,
+        step_strands, step_strands_in_lanes, Effect, Effects, Grab, Libm, Material, Math, Mode,
+        Params, Pose, Real, Shake, StepReport, Strand, Vec3,
     };
 
     const N: usize = 32;
@@ -62,6 +64,7 @@ mod rod_blocks {
         implicit_beside_explicit: u32,
         different_iterations: u32,
         roll_backs: u32,
+        grabbed: u32,
     }
 
     /// A strand of 24 nodes leaving the head along `normal`: straight, wavy or curly.
@@ -98,6 +101,7 @@ mod rod_blocks {
                 Effect::Twist,
                 Effect::Inextensibility,
                 Effect::Collisions,
+                Effect::Grabs,
             ]),
             ..Params::DEFAULT
         };
@@ -130,6 +134,9 @@ mod rod_blocks {
             attached_to_head: true,
         }];
         let mut reference: Vec<Strand<N>> = (0..STRANDS).map(strand).collect();
+        // A hand holding strand 1 at node 14, moving with the head.
+        let held = reference[1].state.position[14];
+        let mut grabs = [Grab::new(1, 14, held, 1.0)];
         let mut lanes = reference.clone();
         let coefficients = p.dftl.at_step(p.dt);
         let mut cases = Cases::default();
@@ -140,6 +147,7 @@ mod rod_blocks {
             let ctx = StepContext::with_coefficients(&p, coefficients, previous, head, &colliders)
                 .at_time(t);
             previous = head;
+            grabs[0].target = head.transform_point(held);
             if k == 700 && mode == Mode::Converge {
                 for strands in [&mut reference, &mut lanes] {
                     strands[2].state.velocity[12].x = Real::NAN;
@@ -150,20 +158,23 @@ mod rod_blocks {
             let mut expected = StepReport::default();
             for (s, strand) in reference.chunks_mut(1).enumerate() {
                 let mut report = StepReport::default();
-                step_strands::<M, N>(&ctx, strand, s as u32, &[], None, &mut report);
+                step_strands::<M, N>(&ctx, strand, s as u32, &grabs, None, &mut report);
                 iterations.push(report.iterations_max);
                 expected.merge(&report);
             }
             let mut report = StepReport::default();
-            step_strands_in_lanes::<M, N, W>(&ctx, &mut lanes, 0, &[], None, &mut report);
+            step_strands_in_lanes::<M, N, W>(&ctx, &mut lanes, 0, &grabs, None, &mut report);
             assert_eq!(report.stage_runs, expected.stage_runs, "step {k}");
             assert_eq!(report.rolled_back, expected.rolled_back, "step {k}");
             assert_eq!(
                 report.iterations_total, expected.iterations_total,
                 "step {k}"
             );
+            let bits = |r: &StepReport| r.grab_forces.map(|f| f.to_array().map(Real::to_bits));
+            assert_eq!(bits(&report), bits(&expected), "step {k}");
             assert_eq!(state_hash(&lanes), state_hash(&reference), "step {k}");
             cases.roll_backs += report.rolled_back;
+            cases.grabbed += u32::from(report.grab_forces[0] != Vec3::ZERO);
             for (block, its) in plans.chunks(W).zip(iterations.chunks(W)) {
                 let substeps: Vec<u32> = block
                     .iter()
@@ -193,6 +204,7 @@ mod rod_blocks {
         ] {
             assert!(cases.same_substeps > 0, "{cases:?}");
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+            assert!(cases.grabbed > 0, "{cases:?}");
         }
         for cases in [
             check::<Libm, 4>(Mode::Converge),
@@ -203,6 +215,7 @@ mod rod_blocks {
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
             assert!(cases.different_iterations > 0, "{cases:?}");
             assert!(cases.roll_backs > 0, "{cases:?}");
+            assert!(cases.grabbed > 0, "{cases:?}");
         }
     }
 }

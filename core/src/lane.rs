@@ -13,7 +13,7 @@ use core::marker::PhantomData;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use crate::math::{Math, Quat, Real, Vec3};
-use crate::precision::{Arithmetic, Kernel, Vector};
+use crate::precision::{Arithmetic, Kernel, Trigonometry, Vector};
 
 /// A scalar or a fixed-width bundle of scalars, operated on lane by lane.
 pub trait Lane:
@@ -188,12 +188,24 @@ impl<const W: usize> Arithmetic for Wide<W> {
         <Self as Lane>::lt(self, other)
     }
     #[inline(always)]
+    fn le(self, other: Self) -> WideMask<W> {
+        WideMask(core::array::from_fn(|l| self.0[l] <= other.0[l]))
+    }
+    #[inline(always)]
+    fn finite(self) -> WideMask<W> {
+        <Self as Lane>::finite(self)
+    }
+    #[inline(always)]
     fn between(self, low: Self, high: Self) -> WideMask<W> {
         <Self as Lane>::lt(low, self) & <Self as Lane>::lt(self, high)
     }
     #[inline(always)]
     fn select(mask: WideMask<W>, a: Self, b: Self) -> Self {
         <Self as Lane>::select(mask, a, b)
+    }
+    #[inline(always)]
+    fn mask(value: bool) -> WideMask<W> {
+        WideMask([value; W])
     }
     #[inline(always)]
     fn any(mask: WideMask<W>) -> bool {
@@ -215,6 +227,26 @@ impl<M: Math, const W: usize> Kernel for Lanes<M, W> {
     #[inline(always)]
     fn sqrt(x: Wide<W>) -> Wide<W> {
         Lane::sqrt::<M>(x)
+    }
+}
+
+/// The twist's trigonometry lane by lane through `M`: the bits `M` gives each strand.
+impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
+    const PI: Wide<W> = Wide([core::f32::consts::PI; W]);
+    const FRAC_1_PI: Wide<W> = Wide([core::f32::consts::FRAC_1_PI; W]);
+    #[inline(always)]
+    fn sin_cos(x: Wide<W>) -> (Wide<W>, Wide<W>) {
+        let both = x.0.map(M::sin_cos);
+        (Wide(both.map(|b| b.0)), Wide(both.map(|b| b.1)))
+    }
+    #[inline(always)]
+    fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {
+        Wide(core::array::from_fn(|l| M::atan2(y.0[l], x.0[l])))
+    }
+    #[inline(always)]
+    fn floor_and_parity(x: Wide<W>) -> (Wide<W>, WideMask<W>) {
+        let both = x.0.map(crate::precision::Scalar::floor_and_parity);
+        (Wide(both.map(|b| b.0)), WideMask(both.map(|b| b.1)))
     }
 }
 

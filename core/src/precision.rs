@@ -10,7 +10,7 @@
 //! names (`dot`, `cross`) sum left to right in scalar code on every target.
 
 use core::fmt::Debug;
-use core::ops::{Add, AddAssign, BitAnd, Div, Mul, MulAssign, Neg, Sub, SubAssign};
+use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
 use glam::DVec3;
 
@@ -34,7 +34,10 @@ pub trait Arithmetic:
     + 'static
 {
     /// One boolean per lane (`bool` for a scalar).
-    type Mask: Copy + BitAnd<Output = Self::Mask>;
+    type Mask: Copy
+        + BitAnd<Output = Self::Mask>
+        + BitOr<Output = Self::Mask>
+        + Not<Output = Self::Mask>;
     /// 0.
     const ZERO: Self;
     /// 1.
@@ -43,12 +46,18 @@ pub trait Arithmetic:
     fn of(x: f32) -> Self;
     /// `self < other`, per lane (false where either is NaN).
     fn lt(self, other: Self) -> Self::Mask;
+    /// `self ≤ other`, per lane (false where either is NaN).
+    fn le(self, other: Self) -> Self::Mask;
+    /// Whether each lane is finite.
+    fn finite(self) -> Self::Mask;
     /// `low < self < high`, per lane (false where any is NaN). For a scalar the second
     /// comparison is skipped when the first fails: a branch, where `lt(…) & lt(…)` made the
     /// Cortex-M4F materialise both flags (1.7 % of the rod's step, QEMU, 32 nodes).
     fn between(self, low: Self, high: Self) -> Self::Mask;
     /// Per lane `if mask { a } else { b }`.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// `value` in every lane.
+    fn mask(value: bool) -> Self::Mask;
     /// Whether any lane of `mask` is set: only to skip work no lane selects, never to change
     /// a lane's result.
     fn any(mask: Self::Mask) -> bool;
@@ -71,6 +80,14 @@ macro_rules! scalar_arithmetic {
                 self < other
             }
             #[inline(always)]
+            fn le(self, other: Self) -> bool {
+                self <= other
+            }
+            #[inline(always)]
+            fn finite(self) -> bool {
+                self.is_finite()
+            }
+            #[inline(always)]
             fn between(self, low: Self, high: Self) -> bool {
                 low < self && self < high
             }
@@ -81,6 +98,10 @@ macro_rules! scalar_arithmetic {
                 } else {
                     b
                 }
+            }
+            #[inline(always)]
+            fn mask(value: bool) -> bool {
+                value
             }
             #[inline(always)]
             fn any(mask: bool) -> bool {
@@ -95,6 +116,26 @@ macro_rules! scalar_arithmetic {
 }
 scalar_arithmetic!(f32);
 scalar_arithmetic!(f64);
+
+/// `if mask { a } else { b }` for a value made of several parts, `blend` choosing lane by lane
+/// where the lanes disagree: for a scalar one branch, which the Cortex-M4F takes for less than
+/// selecting each part (the hair-optimised sweep's choices cost 3 % of the rod's step more
+/// as selects).
+#[inline(always)]
+pub fn select_whole<R: Arithmetic, T>(
+    mask: R::Mask,
+    a: T,
+    b: T,
+    blend: impl FnOnce(R::Mask, T, T) -> T,
+) -> T {
+    if R::all(mask) {
+        a
+    } else if R::any(mask) {
+        blend(mask, a, b)
+    } else {
+        b
+    }
+}
 
 /// A floating-point scalar: `f32` or `f64`.
 pub trait Scalar: Arithmetic<Mask = bool> + Default + PartialOrd {
@@ -263,12 +304,22 @@ pub trait Kernel: Copy + 'static {
     fn sqrt(x: Self::R) -> Self::R;
 }
 
-/// A scalar, a vector and the few transcendental functions the kernels call.
-pub trait Precision: Kernel<R: Scalar> {
+/// A [`Kernel`] with the few transcendental functions the twist calls, per lane.
+pub trait Trigonometry: Kernel {
+    /// π.
+    const PI: Self::R;
+    /// 1/π.
+    const FRAC_1_PI: Self::R;
     /// `(sin x, cos x)`.
     fn sin_cos(x: Self::R) -> (Self::R, Self::R);
     /// Four-quadrant arctangent of `y / x`.
     fn atan2(y: Self::R, x: Self::R) -> Self::R;
+    /// [`Scalar::floor_and_parity`] per lane.
+    fn floor_and_parity(x: Self::R) -> (Self::R, <Self::R as Arithmetic>::Mask);
+}
+
+/// A scalar, a vector and the few transcendental functions the kernels call.
+pub trait Precision: Trigonometry<R: Scalar> {
     /// The simulation's vector `v` in this precision.
     fn vector(v: Vec3) -> Self::V;
     /// `v` rounded to the simulation's vector.
@@ -284,8 +335,9 @@ impl<M: Math> Kernel for M {
     }
 }
 
-/// Every math backend is the `f32` precision the step runs in.
-impl<M: Math> Precision for M {
+impl<M: Math> Trigonometry for M {
+    const PI: Real = core::f32::consts::PI;
+    const FRAC_1_PI: Real = core::f32::consts::FRAC_1_PI;
     #[inline(always)]
     fn sin_cos(x: Real) -> (Real, Real) {
         M::sin_cos(x)
@@ -294,6 +346,14 @@ impl<M: Math> Precision for M {
     fn atan2(y: Real, x: Real) -> Real {
         M::atan2(y, x)
     }
+    #[inline(always)]
+    fn floor_and_parity(x: Real) -> (Real, bool) {
+        Scalar::floor_and_parity(x)
+    }
+}
+
+/// Every math backend is the `f32` precision the step runs in.
+impl<M: Math> Precision for M {
     #[inline(always)]
     fn vector(v: Vec3) -> Vec3 {
         v
@@ -318,7 +378,9 @@ impl Kernel for F64 {
     }
 }
 
-impl Precision for F64 {
+impl Trigonometry for F64 {
+    const PI: f64 = core::f64::consts::PI;
+    const FRAC_1_PI: f64 = core::f64::consts::FRAC_1_PI;
     #[inline(always)]
     fn sin_cos(x: f64) -> (f64, f64) {
         libm::sincos(x)
@@ -327,6 +389,13 @@ impl Precision for F64 {
     fn atan2(y: f64, x: f64) -> f64 {
         libm::atan2(y, x)
     }
+    #[inline(always)]
+    fn floor_and_parity(x: f64) -> (f64, bool) {
+        Scalar::floor_and_parity(x)
+    }
+}
+
+impl Precision for F64 {
     #[inline(always)]
     fn vector(v: Vec3) -> DVec3 {
         DVec3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z))

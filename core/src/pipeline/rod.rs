@@ -177,9 +177,9 @@ pub(super) fn integrate<M: Math, const N: usize>(
     }
 }
 
-/// Lines 5–11 of a strand's step, after its forces and integration: root coupling, the root
-/// frame in time, the projection, the Bishop frame in space and the twist, the guard.
-/// `angles` are the `(cos θ^j, sin θ^j)` the forces used; `frames` a buffer for the frames.
+/// Lines 5–11 of a strand's step, after its forces and integration: [`constrain`], the twist
+/// ([`twist_alone`]) and [`judge`]. `angles` are the `(cos θ^j, sin θ^j)` the forces used;
+/// `frames` a buffer for the frames.
 #[allow(clippy::too_many_arguments)] // the step's inputs, its strand, and what it began with
 pub(super) fn finish<M: Math, const N: usize>(
     strand: &mut Strand<N>,
@@ -191,25 +191,59 @@ pub(super) fn finish<M: Math, const N: usize>(
     angles: &[[Real; 2]; N],
     report: &mut StepReport,
 ) {
-    let gates = &ctx.gates;
-    let (start, clamped) = (&begun.start, &begun.clamped);
-    // Sec. 8.1: root coupling; the root frame follows in time (line 9).
+    constrain(strand, ctx, grabs, index, begun, report);
+    twist_alone(strand, ctx, begun, frames, angles, report);
+    judge(strand, ctx, index, begun, report);
+}
+
+/// Lines 5–9 (time): root coupling (Sec. 8.1), the root frame carried in time, then the fast
+/// manifold projection (inextensibility, collisions, grabs) and the velocities.
+#[inline(always)]
+pub(super) fn constrain<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    grabs: &[Grab],
+    index: u32,
+    begun: &Begun<M, N>,
+    report: &mut StepReport,
+) {
     root_coupling(strand, ctx, report);
-    if let Some(tangent) = start.root_tangent {
+    if let Some(tangent) = begun.start.root_tangent {
         carry_root_frame::<M, N>(strand, ctx, tangent);
     }
-    // Lines 5–8: fast manifold projection (inextensibility, collisions, grabs), velocities.
-    if gates.projection {
+    if ctx.gates.projection {
         project_constraints::<M, N>(strand, ctx, grabs, index, report);
     }
-    // Lines 9–10: the Bishop frame in space of the new centreline, then the twist.
-    if let (true, Some(frames)) = (gates.twist, frames) {
+}
+
+/// Lines 9 (space) and 10 on one strand: the Bishop frame of the new centreline in `frames`,
+/// then the twist.
+#[inline(always)]
+pub(super) fn twist_alone<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    begun: &Begun<M, N>,
+    frames: Option<&mut RodFrames<M, N>>,
+    angles: &[[Real; 2]; N],
+    report: &mut StepReport,
+) {
+    if let (true, Some(frames)) = (ctx.gates.twist, frames) {
         frames.refresh(strand);
-        let saved = start.clamped_frames.as_ref();
-        twist::update(strand, ctx, clamped, frames, saved, angles, report);
+        let saved = begun.start.clamped_frames.as_ref();
+        twist::update(strand, ctx, &begun.clamped, frames, saved, angles, report);
     }
-    // Line 11: the guard. A strand the explicit substeps lost takes the implicit step from now.
-    let verdict = |s: &Strand<N>, _| sound(s, gates.inextensibility);
+}
+
+/// Line 11: the guard. A strand the explicit substeps lost takes the implicit step from now.
+#[inline(always)]
+pub(super) fn judge<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    index: u32,
+    begun: &Begun<M, N>,
+    report: &mut StepReport,
+) {
+    let verdict = |s: &Strand<N>, _| sound(s, ctx.gates.inextensibility);
     if guard(strand, &begun.last_good, verdict, index, report) {
         strand.schedule.implicit_bending = true;
     }

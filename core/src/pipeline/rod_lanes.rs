@@ -19,11 +19,11 @@ use crate::rod::integrate::{starting_at, symplectic_euler, Nodes};
 use crate::rod::substeps::{
     inextensibility_between_substeps, smallest_binormal_denominator_in_lane, Integration,
 };
-use crate::rod::twist::ClampedFrames;
+use crate::rod::twist::{hair_optimised_twist_with_angles, ClampedFrames, TwistMethod};
 use crate::rod::{ClampedSegments, ElasticTerms};
 use crate::strand::Strand;
 
-use super::rod::{begin, finish, integrate, starting_from, Begun, Starting};
+use super::rod::{begin, constrain, integrate, judge, starting_from, twist_alone, Begun, Starting};
 
 /// Steps `strands` (at most `W`) by `ctx.dt`, as [`super::rod::step_strand`] steps each, with
 /// the same bits. `first_strand` is the index of `strands[0]` in the scene; `accelerations`,
@@ -172,7 +172,9 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         }
     }
 
-    /// Lines 5–11 (`super::rod::finish`), strand by strand.
+    /// Lines 5–11: the constraints strand by strand (`super::rod::constrain`), the twist of
+    /// the lanes' strands in lanes ([`twist_in_lanes`]) and of the others alone, the guard
+    /// strand by strand.
     fn finish(
         &mut self,
         strands: &mut [Strand<N>],
@@ -183,20 +185,78 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
     ) {
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
             if let Some(begun) = self.begun[lane].as_ref() {
-                let (index, angles) = (first_strand + lane as u32, &self.angles[lane]);
-                finish(
+                constrain(
                     strand,
                     ctx,
                     grabs,
-                    index,
+                    first_strand + lane as u32,
                     begun,
-                    self.frames.as_mut(),
-                    angles,
                     report,
                 );
             }
         }
+        // The hair-optimised twist in lanes for the strands in them that hold no segment but
+        // the root (a grabbed segment's saved frame is transported strand by strand).
+        let in_lanes: [bool; W] = core::array::from_fn(|lane| {
+            let free = self.begun[lane]
+                .as_ref()
+                .is_some_and(|b| b.clamped.others().next().is_none());
+            free && self.gathered[lane]
+        });
+        let lanes_twist = ctx.gates.twist
+            && ctx.params.rod.twist == TwistMethod::HairOptimised
+            && in_lanes.iter().filter(|&&l| l).count() > 1;
+        if let (Some(block), true) = (self.block.as_mut(), lanes_twist) {
+            twist_in_lanes(
+                block,
+                &mut self.lane_frames,
+                strands,
+                &in_lanes,
+                ctx,
+                report,
+            );
+        }
+        for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+            let Some(begun) = self.begun[lane].as_ref() else {
+                continue;
+            };
+            if !(lanes_twist && in_lanes[lane]) {
+                let frames = self.frames.as_mut();
+                twist_alone(strand, ctx, begun, frames, &self.angles[lane], report);
+            }
+            judge(strand, ctx, first_strand + lane as u32, begun, report);
+        }
     }
+}
+
+/// Lines 9 (space) and 10 for the strands `in_lanes` names, in lanes: their new centrelines
+/// and root frames gathered, the lanes' frame pass, the hair-optimised twist, the angles
+/// scattered back. The same kernels as `super::rod::twist_alone` on each strand alone, with
+/// the angles its forces used (the block's, from the start of the step).
+fn twist_in_lanes<M: Math, const N: usize, const W: usize>(
+    block: &mut LaneBlock<N, W>,
+    frames: &mut RodFrames<Lanes<M, W>, N>,
+    strands: &mut [Strand<N>],
+    in_lanes: &[bool; W],
+    ctx: &StepContext,
+    report: &mut StepReport,
+) {
+    report.ran_on(Stage::Twist, in_lanes.iter().filter(|&&l| l).count() as u32);
+    block.put_centrelines(strands, in_lanes);
+    let nodes = block.nodes;
+    frames.recompute(
+        &block.position[..nodes],
+        block.root_frame,
+        &block.rest.rest_length,
+    );
+    let segments = nodes.saturating_sub(1);
+    let (terms, clamped) = (
+        ElasticTerms::of(&ctx.gates),
+        [ClampedSegments::ROOT_ONLY; W],
+    );
+    let theta = &mut block.theta[..segments];
+    hair_optimised_twist_with_angles(frames, &block.rest, &clamped, terms, theta, &block.cos_sin);
+    block.take_angles(strands, in_lanes);
 }
 
 /// Whether `k` substeps run without a projection between them (what the lanes do).

@@ -104,6 +104,35 @@ impl<const N: usize, const W: usize> LaneBlock<N, W> {
         self.put_rest(lane, &rest.rod);
     }
 
+    /// Writes the centreline, root frame and angles of the strands `in_lanes` names (after
+    /// their projection: what the twist reads) into their lanes; the others keep theirs.
+    pub fn put_centrelines(&mut self, strands: &[Strand<N>], in_lanes: &[bool; W]) {
+        for (lane, strand) in strands.iter().enumerate().take(W) {
+            if !in_lanes[lane] {
+                continue;
+            }
+            let state = &strand.state;
+            for i in 0..self.nodes {
+                self.position[i].set_lane(lane, state.position[i]);
+                self.theta[i].0[lane] = state.theta[i];
+            }
+            self.root_frame.set_lane(lane, state.root_frame);
+        }
+    }
+
+    /// Writes the material angles of the lanes `in_lanes` names back into their strands (the
+    /// twist's result; `θ^0` is the root coupling's and stays).
+    pub fn take_angles(&self, strands: &mut [Strand<N>], in_lanes: &[bool; W]) {
+        let segments = self.nodes.saturating_sub(1);
+        for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+            if in_lanes[lane] {
+                for j in 1..segments {
+                    strand.state.theta[j] = self.theta[j].0[lane];
+                }
+            }
+        }
+    }
+
     /// Writes the rod rest data `rod` into lane `lane`.
     fn put_rest(&mut self, lane: usize, rod: &RodRest<N>) {
         let r = &mut self.rest;

@@ -20,7 +20,7 @@
 
 pub use super::frames::{material_angles, material_curvature, representative_near, RodFrames};
 use super::{ClampedLanes, ClampedSegments, ElasticTerms};
-use crate::precision::{Arithmetic, Kernel, Precision, Scalar, Vector};
+use crate::precision::{Arithmetic, Kernel, Precision, Vector};
 use crate::strand::RodRest;
 
 /// `B^j = diag(µα^j, α^j)`, or zero when bending is off.
@@ -74,7 +74,7 @@ pub fn node_bending_energy<P: Precision, const N: usize>(
 /// Twist energy at node `i`: `β (θ^i − θ^{i−1} − m̂_i)² / l̂_i`.
 #[inline(always)]
 #[must_use]
-pub fn node_twist_energy<const N: usize, R: Scalar>(
+pub fn node_twist_energy<const N: usize, R: Arithmetic>(
     rest: &RodRest<N, R>,
     terms: ElasticTerms,
     i: usize,

@@ -8,7 +8,7 @@
 
 use crate::frames::{curvature_binormal, transport_perpendicular};
 use crate::math::Math;
-use crate::precision::{Arithmetic, Kernel, Precision, Scalar, Vector};
+use crate::precision::{Arithmetic, Kernel, Precision, Trigonometry, Vector};
 use crate::strand::Strand;
 
 /// The representative of the direction `(cos φ, sin φ)` (an unoriented line, defined mod π)
@@ -16,17 +16,17 @@ use crate::strand::Strand;
 /// `(cos θ, sin θ)`, and whether `k` is odd (the direction flipped).
 #[inline(always)]
 #[must_use]
-pub fn representative_near<R: Scalar>(
-    phi: R,
-    direction: [R; 2],
-    reference: R,
-) -> (R, [R; 2], bool) {
+pub fn representative_near<P: Trigonometry>(
+    phi: P::R,
+    direction: [P::R; 2],
+    reference: P::R,
+) -> (P::R, [P::R; 2], <P::R as Arithmetic>::Mask) {
     let [c, s] = direction;
     // On the twist sweep's sequential chain (`reference` is the neighbour's new angle): a
     // multiplication by 1/π rather than a division, and the parity from the integer.
-    let (k, odd) = ((reference - phi) * R::FRAC_1_PI + R::of(0.5)).floor_and_parity();
-    let cos_sin = if odd { [-c, -s] } else { [c, s] };
-    (phi + k * R::PI, cos_sin, odd)
+    let (k, odd) = P::floor_and_parity((reference - phi) * P::FRAC_1_PI + P::R::of(0.5));
+    let cos_sin = [P::R::select(odd, -c, c), P::R::select(odd, -s, s)];
+    (phi + k * P::PI, cos_sin, odd)
 }
 
 /// The frames of a strand's current configuration: segments, tangents, curvature binormals,
@@ -206,6 +206,18 @@ pub fn binormal_direction<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     j: usize,
 ) -> Option<[P::R; 2]> {
+    let (direction, some) = binormal_direction_in_lanes(frames, j);
+    some.then_some(direction)
+}
+
+/// [`binormal_direction`] per lane: the direction, and where there is one (elsewhere the
+/// direction is not meaningful).
+#[inline(always)]
+#[must_use]
+pub fn binormal_direction_in_lanes<P: Kernel, const N: usize>(
+    frames: &RodFrames<P, N>,
+    j: usize,
+) -> ([P::R; 2], <P::R as Arithmetic>::Mask) {
     let n = frames.interior();
     let fade = P::R::of(BINORMAL_FADE);
     // Σ_k z_k / r_k with z_k = (a² − b², 2ab) and r_k = a² + b² + ε², as `sum / scale`.
@@ -229,19 +241,23 @@ pub fn binormal_direction<P: Precision, const N: usize>(
     let (x, y) = (sum[0] * inverse_scale, sum[1] * inverse_scale);
     let weight2 = x * x + y * y;
     let min = P::R::of(BINORMAL_MIN_WEIGHT);
-    if weight2 <= min * min || !weight2.is_finite() {
-        return None;
+    let some = !(weight2.le(min * min) | !weight2.finite());
+    if !P::R::any(some) {
+        return ([P::R::ONE, P::R::ZERO], some);
     }
     let weight = P::sqrt(weight2);
-    let half_angle = if x >= P::R::ZERO {
-        [weight + x, y]
-    } else {
-        [y, weight - x]
-    };
+    let right = P::R::ZERO.le(x);
+    let half_angle = [
+        P::R::select(right, weight + x, y),
+        P::R::select(right, y, weight - x),
+    ];
     let inverse_length =
         P::R::ONE / P::sqrt(half_angle[0] * half_angle[0] + half_angle[1] * half_angle[1]);
-    Some([
-        half_angle[0] * inverse_length,
-        half_angle[1] * inverse_length,
-    ])
+    (
+        [
+            half_angle[0] * inverse_length,
+            half_angle[1] * inverse_length,
+        ],
+        some,
+    )
 }

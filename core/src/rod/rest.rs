@@ -89,7 +89,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
             self.rest_theta[j] = match binormal_direction(frames, j) {
                 Some(direction) => {
                     let phi = P::atan2(direction[1], direction[0]);
-                    representative_near(phi, direction, previous).0
+                    representative_near::<P>(phi, direction, previous).0
                 }
                 None => previous,
             };

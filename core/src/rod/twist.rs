@@ -16,15 +16,16 @@ use super::energy::{
     twist_twist_derivative,
 };
 use super::frames::{
-    binormal_direction, material_angles, material_curvature, representative_near, RodFrames,
+    binormal_direction_in_lanes, material_angles, material_curvature, representative_near,
+    RodFrames,
 };
-use super::{ClampedSegments, ElasticTerms};
+use super::{ClampedLanes, ClampedSegments, ElasticTerms};
 use crate::capacities::MAX_CLAMPED;
 use crate::context::StepContext;
 use crate::frames::{angle_in_frame, material_frame, parallel_transport, unwrap_near};
 use crate::math::{Math, Real};
 use crate::params::Mode;
-use crate::precision::{Arithmetic, Precision, Scalar, Vector};
+use crate::precision::{select_whole, Arithmetic, Kernel, Precision, Scalar, Trigonometry, Vector};
 use crate::report::{Flags, Stage, StepReport};
 use crate::strand::{RodRest, Strand};
 
@@ -75,7 +76,7 @@ pub fn update<M: Math, const N: usize>(
 /// `Σ_i ½(1/l̂_i)(±ω − ω̂)ᵀB(±ω − ω̂)`, since `ω(θ ± π) = −ω(θ)`. Each is summed as squares
 /// (not expanded), so near rest the comparison is not lost to cancellation.
 #[inline(always)]
-fn local_bending<P: Precision, const N: usize>(
+fn local_bending<P: Kernel, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,
@@ -105,7 +106,7 @@ fn local_bending<P: Precision, const N: usize>(
 }
 
 /// The twist energy of nodes `j`, `j + 1` with `θ^j = candidate` and the neighbours' angles.
-fn local_twist<const N: usize, R: Scalar>(
+fn local_twist<const N: usize, R: Arithmetic>(
     rest: &RodRest<N, R>,
     terms: ElasticTerms,
     theta: &[R],
@@ -163,10 +164,10 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
 /// Trigonometry: one `atan2` per segment (θ is stored as an angle); the cosines and sines are
 /// carried along the sweep. Angles stay continuous in time: every choice is made relative to
 /// the neighbour or the current angle, and `θ^0` is unwrapped against its previous value.
-pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
+pub fn hair_optimised_twist_with_angles<P: Trigonometry, C: ClampedLanes<P::R>, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
-    clamped: &ClampedSegments,
+    clamped: &C,
     terms: ElasticTerms,
     theta: &mut [P::R],
     current: &[[P::R; 2]],
@@ -179,10 +180,11 @@ pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
     // Two passes. The first computes everything that does not depend on the angles the sweep
     // chooses: the binormal directions with their `atan2` and the candidates' bending
     // energies. With nothing linking one segment to the next, the processor overlaps them.
-    // The second is the sweep root → tip, which only compares (see [`Candidates`]).
-    let mut prepared = [Candidates::<P::R>::default(); N];
+    // The second is the sweep root → tip, which only compares (see [`Candidates`]). A clamped
+    // segment's candidates are computed and not used (lanes: another strand's may be free).
+    let mut prepared = [Candidates::<P::R>::none(); N];
     for (j, slot) in prepared.iter_mut().enumerate().take(segments).skip(1) {
-        if !clamped.contains(j) {
+        if !P::R::all(clamped.clamped(j)) {
             *slot = Candidates::of(frames, rest, terms, j, theta[j], current.get(j).copied());
         }
     }
@@ -191,65 +193,119 @@ pub fn hair_optimised_twist_with_angles<P: Precision, const N: usize>(
     let (s, c) = P::sin_cos(theta[0]);
     let mut previous = [c, s];
     for (j, prepared) in prepared.iter().enumerate().take(segments).skip(1) {
-        if clamped.contains(j) {
-            let (s, c) = P::sin_cos(theta[j]);
-            previous = [c, s];
-            continue;
-        }
-        // Zero local twist: θ^{j−1} + m̂_j, its cosine and sine by the rest rotation.
-        let reference = theta[j - 1] + rest.rest_twist[j];
-        let [cm, sm] = rest.rest_twist_rotation[j];
-        let reference_cos_sin = [
-            previous[0] * cm - previous[1] * sm,
-            previous[1] * cm + previous[0] * sm,
-        ];
-        let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
-        // The current angle first: a candidate must be strictly lower to replace it.
-        let kept = theta[j];
-        let mut best = (kept, prepared.kept_cos_sin);
-        let mut best_energy = prepared.kept_bending + twist(kept);
-        let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
-        let mut consider = |candidate: P::R, cos_sin: [P::R; 2], bending: P::R| {
-            let energy = bending + twist(candidate);
-            if energy < best_energy {
-                best = (candidate, cos_sin);
-                best_energy = energy;
-            }
+        let held = clamped.clamped(j);
+        let (chosen, chosen_cos_sin) = if P::R::all(held) {
+            (theta[j], [P::R::ONE, P::R::ZERO])
+        } else {
+            choose(rest, terms, frames, theta, j, n, prepared, previous)
         };
-        consider(reference, reference_cos_sin, continued);
-        if let Some(binormal) = prepared.binormal {
-            let (angle, cos_sin, odd) =
-                representative_near(binormal.angle, binormal.direction, reference);
-            // `ω(θ + π) = −ω(θ)`: the flipped representative swaps the two energies (the
-            // same bits: negation is exact and rounding symmetric).
-            let (aligned, flipped_bending) = if odd {
-                (binormal.bending.1, binormal.bending.0)
-            } else {
-                binormal.bending
-            };
-            let flipped = [-cos_sin[0], -cos_sin[1]];
-            consider(angle, cos_sin, aligned);
-            consider(angle + P::R::PI, flipped, flipped_bending);
-            consider(angle - P::R::PI, flipped, flipped_bending);
+        if P::R::any(held) {
+            let (s, c) = P::sin_cos(theta[j]);
+            theta[j] = P::R::select(held, theta[j], chosen);
+            previous = [
+                P::R::select(held, c, chosen_cos_sin[0]),
+                P::R::select(held, s, chosen_cos_sin[1]),
+            ];
+        } else {
+            theta[j] = chosen;
+            previous = chosen_cos_sin;
         }
-        theta[j] = best.0;
-        previous = best.1;
     }
+}
+
+/// The sweep's choice for segment `j` (see [`hair_optimised_twist_with_angles`]) with
+/// `(cos θ^{j−1}, sin θ^{j−1})` = `previous`: the candidate of least local energy, the current
+/// angle winning ties. Returns the angle and its cosine and sine.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)] // the sweep's state at one segment
+fn choose<P: Trigonometry, const N: usize>(
+    rest: &RodRest<N, P::R>,
+    terms: ElasticTerms,
+    frames: &RodFrames<P, N>,
+    theta: &[P::R],
+    j: usize,
+    n: usize,
+    prepared: &Candidates<P::R>,
+    previous: [P::R; 2],
+) -> (P::R, [P::R; 2]) {
+    // Zero local twist: θ^{j−1} + m̂_j, its cosine and sine by the rest rotation.
+    let reference = theta[j - 1] + rest.rest_twist[j];
+    let [cm, sm] = rest.rest_twist_rotation[j];
+    let reference_cos_sin = [
+        previous[0] * cm - previous[1] * sm,
+        previous[1] * cm + previous[0] * sm,
+    ];
+    let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
+    // The current angle first: a candidate must be strictly lower to replace it.
+    let kept = theta[j];
+    let mut best = (kept, prepared.kept_cos_sin);
+    let mut best_energy = prepared.kept_bending + twist(kept);
+    let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
+    let mut consider = |some, candidate: P::R, cos_sin: [P::R; 2], bending: P::R| {
+        let energy = bending + twist(candidate);
+        let lower = some & energy.lt(best_energy);
+        let blend = |m, a: Choice<P::R>, b: Choice<P::R>| Choice {
+            angle: P::R::select(m, a.angle, b.angle),
+            cos_sin: [0, 1].map(|k| P::R::select(m, a.cos_sin[k], b.cos_sin[k])),
+            energy: P::R::select(m, a.energy, b.energy),
+        };
+        let now = Choice {
+            angle: best.0,
+            cos_sin: best.1,
+            energy: best_energy,
+        };
+        let this = Choice {
+            angle: candidate,
+            cos_sin,
+            energy,
+        };
+        let chosen = select_whole::<P::R, _>(lower, this, now, blend);
+        best = (chosen.angle, chosen.cos_sin);
+        best_energy = chosen.energy;
+    };
+    consider(P::R::mask(true), reference, reference_cos_sin, continued);
+    let binormal = &prepared.binormal;
+    if P::R::any(prepared.has_binormal) {
+        let some = prepared.has_binormal;
+        let (angle, cos_sin, odd) =
+            representative_near::<P>(binormal.angle, binormal.direction, reference);
+        // `ω(θ + π) = −ω(θ)`: the flipped representative swaps the two energies (the same
+        // bits: negation is exact and rounding symmetric).
+        let (at, opposite) = binormal.bending;
+        let aligned = P::R::select(odd, opposite, at);
+        let flipped_bending = P::R::select(odd, at, opposite);
+        let flipped = [-cos_sin[0], -cos_sin[1]];
+        consider(some, angle, cos_sin, aligned);
+        consider(some, angle + P::PI, flipped, flipped_bending);
+        consider(some, angle - P::PI, flipped, flipped_bending);
+    }
+    best
+}
+
+/// A candidate of the sweep: an angle, its cosine and sine, and its local energy.
+#[derive(Clone, Copy)]
+struct Choice<R> {
+    angle: R,
+    cos_sin: [R; 2],
+    energy: R,
 }
 
 /// What the hair-optimised sweep needs of one segment that does not depend on the angles it
 /// chooses before it: the current angle's cosine, sine and bending energy, and the binormal
-/// direction's angle and bending energies.
-#[derive(Clone, Copy, Debug, Default)]
-struct Candidates<R> {
+/// direction's angle and bending energies (where there is one, `has_binormal`).
+#[derive(Clone, Copy, Debug)]
+struct Candidates<R: Arithmetic> {
     kept_cos_sin: [R; 2],
     /// Bending energy of nodes `j`, `j + 1` at the current angle.
     kept_bending: R,
-    binormal: Option<Binormal<R>>,
+    /// Where the segment has a binormal direction.
+    has_binormal: R::Mask,
+    binormal: Binormal<R>,
 }
 
-/// The binormal direction of a segment ([`binormal_direction`]) and what the sweep needs of it.
-#[derive(Clone, Copy, Debug, Default)]
+/// The binormal direction of a segment ([`binormal_direction_in_lanes`]) and what the sweep
+/// needs of it.
+#[derive(Clone, Copy, Debug)]
 struct Binormal<R> {
     /// `(cos φ, sin φ)`.
     direction: [R; 2],
@@ -259,9 +315,29 @@ struct Binormal<R> {
     bending: (R, R),
 }
 
-impl<R: Scalar> Candidates<R> {
+impl<R: Arithmetic> Binormal<R> {
+    /// No direction.
+    const NONE: Self = Binormal {
+        direction: [R::ONE, R::ZERO],
+        angle: R::ZERO,
+        bending: (R::ZERO, R::ZERO),
+    };
+}
+
+impl<R: Arithmetic> Candidates<R> {
+    /// No segment's.
     #[inline(always)]
-    fn of<P: Precision<R = R>, const N: usize>(
+    fn none() -> Self {
+        Candidates {
+            kept_cos_sin: [R::ONE, R::ZERO],
+            kept_bending: R::ZERO,
+            has_binormal: R::mask(false),
+            binormal: Binormal::NONE,
+        }
+    }
+
+    #[inline(always)]
+    fn of<P: Trigonometry<R = R>, const N: usize>(
         frames: &RodFrames<P, N>,
         rest: &RodRest<N, R>,
         terms: ElasticTerms,
@@ -273,14 +349,21 @@ impl<R: Scalar> Candidates<R> {
             let (s, c) = P::sin_cos(kept);
             [c, s]
         });
-        Candidates {
-            kept_cos_sin,
-            kept_bending: local_bending(frames, rest, terms, j, kept_cos_sin).0,
-            binormal: binormal_direction(frames, j).map(|direction| Binormal {
+        let (direction, has_binormal) = binormal_direction_in_lanes(frames, j);
+        let binormal = if R::any(has_binormal) {
+            Binormal {
                 direction,
                 angle: P::atan2(direction[1], direction[0]),
                 bending: local_bending(frames, rest, terms, j, direction),
-            }),
+            }
+        } else {
+            Binormal::NONE
+        };
+        Candidates {
+            kept_cos_sin,
+            kept_bending: local_bending(frames, rest, terms, j, kept_cos_sin).0,
+            has_binormal,
+            binormal,
         }
     }
 }
@@ -631,7 +714,7 @@ mod tests {
     use crate::precision::F64;
     use crate::rod::energy::elastic_energy;
     use crate::rod::energy::tests::{rest_points, Rng, Shape, NODES};
-    use crate::rod::frames::{BINORMAL_FADE, BINORMAL_MIN_WEIGHT};
+    use crate::rod::frames::{binormal_direction, BINORMAL_FADE, BINORMAL_MIN_WEIGHT};
     use glam::DVec3;
 
     type Rest = RodRest<NODES, f64>;
