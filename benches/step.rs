@@ -17,7 +17,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use hairsim::builtin;
 use hairsim::scene::Prepared;
-use hairsim::sim::{scene_inputs, Sim};
+use hairsim::sim::{scene_inputs, Layout, Sim};
 use hairsim_core::scenes::firmware;
 use hairsim_core::{Libm, World};
 
@@ -45,7 +45,12 @@ fn prepared(name: &str) -> Prepared {
 
 /// A one-thread simulation of `prepared` after `steps` steps.
 fn warmed_up(prepared: &Prepared, steps: u64) -> Sim<NODES, Libm> {
-    let mut sim = Sim::<NODES, Libm>::new(prepared, 1).expect("scene builds");
+    warmed_up_in(prepared, steps, Layout::Blocks)
+}
+
+/// [`warmed_up`], stepping the strands in `layout`.
+fn warmed_up_in(prepared: &Prepared, steps: u64, layout: Layout) -> Sim<NODES, Libm> {
+    let mut sim = Sim::<NODES, Libm>::with_layout(prepared, 1, layout).expect("scene builds");
     for k in 0..steps {
         sim.step(&scene_inputs::<Libm>(prepared, k));
     }
@@ -121,5 +126,30 @@ fn firmware_step(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, rod_table_1, stiff_hair, firmware_step);
+/// Issue 22: the rod's blocks (strands in lanes, `Layout::Blocks`, the default) against one
+/// strand at a time (`Layout::PerStrand`, the firmware's path) in the same run, Head #1 and
+/// Stand #1 in motion as in Table 1. Goal: Head #1 in blocks at least 3× faster.
+fn rod_lanes(c: &mut Criterion) {
+    let mut group = c.benchmark_group("Rod blocks against one strand at a time (ms per step)");
+    for name in ["head-1", "stand-1"] {
+        let prepared = prepared(name);
+        for (layout, label) in [
+            (Layout::PerStrand, "per strand"),
+            (Layout::Blocks, "blocks"),
+        ] {
+            let mut sim = warmed_up_in(&prepared, WARM_UP_STEPS, layout);
+            let mut k = WARM_UP_STEPS;
+            group.bench_function(format!("{name} {label}"), |b| {
+                b.iter(|| {
+                    let report = sim.step(&scene_inputs::<Libm>(&prepared, k));
+                    k += 1;
+                    report
+                })
+            });
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, rod_table_1, stiff_hair, firmware_step, rod_lanes);
 criterion_main!(benches);
