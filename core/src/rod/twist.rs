@@ -143,8 +143,9 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
 /// `(cos θ^j, sin θ^j)` of the angles passed in.
 ///
 /// Sweep root → tip (a fixed order: determinism) over the unclamped segments, with the
-/// already-updated `θ^{j−1}`: take the binormal direction ([`binormal_direction_in_lanes`]) as the
-/// representative mod π nearest `θ^{j−1} + m̂_j`, then keep whichever of the candidates has the
+/// already-updated `θ^{j−1}`: take the binormal direction
+/// ([`binormal_direction_in_lanes`]) as the representative mod π nearest
+/// `θ^{j−1} + m̂_j`, then keep whichever of the candidates has the
 /// least local energy, evaluated exactly (the paper's closed-form criteria assume uniform `l̂`
 /// and neighbours at rest twist; `ω(θ ± π) = −ω(θ)`). The candidates:
 /// * the paper's three, `θ`, `θ + π`, `θ − π`;
