@@ -35,9 +35,11 @@ fn glam_math_goes_through_libm() {
 /// per-strand path, bit for bit, every step of 1,500: in fixed-cost mode, where every lane of
 /// a block takes the same 4 substeps and the lanes run them, and in converge mode on blocks
 /// whose strands differ in their substep count, in the implicit switch (a stiff strand), in
-/// their projection iterations, and in a roll-back (a NaN put into one strand's velocity); a
-/// grab holds a node of one strand throughout (its clamped segment steps that strand's twist
-/// alone). The twist is the hair-optimised one (the default), in lanes.
+/// their projection iterations (the projection runs in lanes), and in a roll-back (a NaN put
+/// into one strand's velocity); a grab holds a node of one strand throughout (its clamped
+/// segment steps that strand's twist and its projection alone), and the head's sphere
+/// touches the strands (contacts found and eliminated lane by lane). The report's projection
+/// findings must match too. The twist is the hair-optimised one (the default), in lanes.
 /// Each of those cases is counted and must have occurred.
 mod rod_blocks {
     use hairsim_core::collide::{Collider, Shape};
@@ -56,7 +58,8 @@ mod rod_blocks {
 
     /// What the blocks met: steps of a block whose lanes all took the same substeps (the
     /// lanes' path), differed in substep count, mixed the implicit step with substeps, or
-    /// differed in projection iterations; and roll-backs.
+    /// differed in projection iterations; roll-backs; steps with a node held by a grab, and
+    /// with nodes in contact with the head.
     #[derive(Debug, Default)]
     struct Cases {
         same_substeps: u32,
@@ -65,6 +68,7 @@ mod rod_blocks {
         different_iterations: u32,
         roll_backs: u32,
         grabbed: u32,
+        contacts: u32,
     }
 
     /// A strand of 24 nodes leaving the head along `normal`: straight, wavy or curly.
@@ -172,6 +176,27 @@ mod rod_blocks {
             );
             let bits = |r: &StepReport| r.grab_forces.map(|f| f.to_array().map(Real::to_bits));
             assert_eq!(bits(&report), bits(&expected), "step {k}");
+            // The projection's findings, in lanes or alone.
+            let pushes =
+                |r: &StepReport| r.collider_forces.map(|f| f.to_array().map(Real::to_bits));
+            assert_eq!(pushes(&report), pushes(&expected), "step {k}");
+            let measures = |r: &StepReport| {
+                let reals = [
+                    r.residual,
+                    r.max_stretch,
+                    r.max_contact_stretch,
+                    r.max_penetration,
+                ];
+                (
+                    reals.map(Real::to_bits),
+                    r.contacts,
+                    r.dropped_rows,
+                    r.cap_hits,
+                    r.flags,
+                )
+            };
+            assert_eq!(measures(&report), measures(&expected), "step {k}");
+            cases.contacts += u32::from(report.contacts > 0);
             assert_eq!(state_hash(&lanes), state_hash(&reference), "step {k}");
             cases.roll_backs += report.rolled_back;
             cases.grabbed += u32::from(report.grab_forces[0] != Vec3::ZERO);
@@ -205,6 +230,7 @@ mod rod_blocks {
             assert!(cases.same_substeps > 0, "{cases:?}");
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
             assert!(cases.grabbed > 0, "{cases:?}");
+            assert!(cases.contacts > 0, "{cases:?}");
         }
         for cases in [
             check::<Libm, 4>(Mode::Converge),
@@ -216,6 +242,7 @@ mod rod_blocks {
             assert!(cases.different_iterations > 0, "{cases:?}");
             assert!(cases.roll_backs > 0, "{cases:?}");
             assert!(cases.grabbed > 0, "{cases:?}");
+            assert!(cases.contacts > 0, "{cases:?}");
         }
     }
 }

@@ -29,6 +29,7 @@ use crate::grab::{apply_slips, retarget, slip_unreachable, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Params};
+use crate::projection::lanes::BlockProjection;
 use crate::report::{Flags, StepReport};
 use crate::strand::Strand;
 
@@ -78,11 +79,13 @@ pub fn step_strands_in_lanes<M: Math, const N: usize, const W: usize>(
     if ctx.params.solver != Solver::Rod {
         return step_strands::<M, N>(ctx, strands, first_strand, grabs, accelerations, report);
     }
+    let mut projection = BlockProjection::<N, W>::default();
     for (b, block) in strands.chunks_mut(W.max(1)).enumerate() {
         let first = b * W.max(1);
         let accelerations = accelerations.and_then(|a| a.get(first * N..(first + block.len()) * N));
-        let index = first_strand + first as u32;
-        rod_lanes::step_block::<M, N, W>(block, ctx, grabs, index, accelerations, report);
+        let at = (grabs, first_strand + first as u32);
+        let scratch = &mut projection;
+        rod_lanes::step_block::<M, N, W>(block, ctx, at, accelerations, scratch, report);
     }
 }
 

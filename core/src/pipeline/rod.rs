@@ -207,12 +207,24 @@ pub(super) fn constrain<M: Math, const N: usize>(
     begun: &Begun<M, N>,
     report: &mut StepReport,
 ) {
+    couple_root(strand, ctx, begun, report);
+    if ctx.gates.projection {
+        project_constraints::<M, N>(strand, ctx, grabs, index, report);
+    }
+}
+
+/// Lines 5–8: root coupling (Sec. 8.1) and the root frame carried in time, the first half
+/// of [`constrain`].
+#[inline(always)]
+pub(super) fn couple_root<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    begun: &Begun<M, N>,
+    report: &mut StepReport,
+) {
     root_coupling(strand, ctx, report);
     if let Some(tangent) = begun.start.root_tangent {
         carry_root_frame::<M, N>(strand, ctx, tangent);
-    }
-    if ctx.gates.projection {
-        project_constraints::<M, N>(strand, ctx, grabs, index, report);
     }
 }
 

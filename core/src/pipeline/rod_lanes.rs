@@ -15,6 +15,8 @@ use crate::forces::{drag, External};
 use crate::grab::Grab;
 use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
+use crate::projection::lanes::{fits_lanes, BlockProjection};
+use crate::projection::project_constraints;
 use crate::report::{Stage, StepReport};
 use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
@@ -27,17 +29,19 @@ use crate::rod::twist::{hair_optimised_twist_with_angles, ClampedFrames, TwistMe
 use crate::rod::{ClampedSegments, ElasticTerms};
 use crate::strand::Strand;
 
-use super::rod::{begin, constrain, integrate, judge, starting_from, twist_alone, Begun, Starting};
+use super::rod::{
+    begin, couple_root, integrate, judge, starting_from, twist_alone, Begun, Starting,
+};
 
 /// Steps `strands` (at most `W`) by `ctx.dt`, as [`super::rod::step_strand`] steps each, with
 /// the same bits. `first_strand` is the index of `strands[0]` in the scene; `accelerations`,
-/// if any, holds `N` per strand.
+/// if any, holds `N` per strand. `projection` is scratch space, made once for many blocks.
 pub fn step_block<M: Math, const N: usize, const W: usize>(
     strands: &mut [Strand<N>],
     ctx: &StepContext,
-    grabs: &[Grab],
-    first_strand: u32,
+    (grabs, first_strand): (&[Grab], u32),
     accelerations: Option<&[Vec3]>,
+    projection: &mut BlockProjection<N, W>,
     report: &mut StepReport,
 ) {
     let count = strands.len().min(W);
@@ -49,7 +53,7 @@ pub fn step_block<M: Math, const N: usize, const W: usize>(
     // Lines 3–4: in lanes, or alone.
     step.integrate(strands, ctx, accelerations, report);
     // Lines 5–11, strand by strand.
-    step.finish(strands, ctx, grabs, first_strand, report);
+    step.finish(strands, ctx, (grabs, first_strand), projection, report);
 }
 
 /// A block's step in the making: its lanes, their frames, and each strand's start.
@@ -183,22 +187,24 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         &mut self,
         strands: &mut [Strand<N>],
         ctx: &StepContext,
-        grabs: &[Grab],
-        first_strand: u32,
+        (grabs, first_strand): (&[Grab], u32),
+        projection: &mut BlockProjection<N, W>,
         report: &mut StepReport,
     ) {
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
             if let Some(begun) = self.begun[lane].as_ref() {
-                constrain(
-                    strand,
-                    ctx,
-                    grabs,
-                    first_strand + lane as u32,
-                    begun,
-                    report,
-                );
+                couple_root(strand, ctx, begun, report);
             }
         }
+        project(
+            strands,
+            &self.begun,
+            ctx,
+            grabs,
+            first_strand,
+            projection,
+            report,
+        );
         // The hair-optimised twist in lanes for the strands in them that hold no segment but
         // the root (a grabbed segment's saved frame is transported strand by strand).
         let in_lanes: [bool; W] = core::array::from_fn(|lane| {
@@ -229,6 +235,44 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
                 twist_alone(strand, ctx, begun, frames, &self.angles[lane], report);
             }
             judge(strand, ctx, first_strand + lane as u32, begun, report);
+        }
+    }
+}
+
+/// Line 9 (time) of each strand with a start in `begun`: the fast manifold projection, in
+/// lanes for the strands laid out alike (`projection::lanes::fits_lanes`) when two or more
+/// are, alone for the others; each strand's result taken in scene order.
+fn project<M: Math, const N: usize, const W: usize>(
+    strands: &mut [Strand<N>],
+    begun: &[Option<Begun<M, N>>; W],
+    ctx: &StepContext,
+    grabs: &[Grab],
+    first_strand: u32,
+    lanes: &mut BlockProjection<N, W>,
+    report: &mut StepReport,
+) {
+    if !ctx.gates.projection {
+        return;
+    }
+    let nodes = strands.first().map_or(0, |s| s.rest.nodes.min(N));
+    let taken: [bool; W] = core::array::from_fn(|lane| {
+        let index = first_strand + lane as u32;
+        let fits = |s: &Strand<N>| fits_lanes(s, ctx, grabs, index, nodes);
+        begun[lane].is_some() && strands.get(lane).is_some_and(fits)
+    });
+    let in_lanes = taken.iter().filter(|&&t| t).count() > 1 && lanes.run::<M>(strands, &taken, ctx);
+    for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+        if begun[lane].is_none() {
+            continue;
+        }
+        match in_lanes && taken[lane] {
+            true => {
+                lanes.finish::<M>(lane, strand, ctx, report);
+            }
+            false => {
+                let index = first_strand + lane as u32;
+                project_constraints::<M, N>(strand, ctx, grabs, index, report);
+            }
         }
     }
 }

@@ -92,27 +92,11 @@ pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u
         if i >= nodes {
             continue;
         }
-        let Some(&(mut contacts)) = rows.contacts.get(i) else {
+        let Some(contacts) = rows.contacts.get_mut(i) else {
             continue;
         };
-        if contacts.count == 0 {
-            rows.contacts[i].kept = 0;
-            continue;
-        }
-        dropped += gram_inverse(&mut contacts);
-        let [c0, c1] = contacts.value;
-        let [inv00, inv01, inv11] = contacts.inverse_gram;
-        let [g0, g1] = contacts.gradient;
-        // One kept row (nearly every contact): `P v = g (g·v)/(g·g)`, the two-row formulas
-        // without their zero terms.
-        let single = contacts.kept <= 1;
-        contacts.displacement = if single {
-            g0 * (inv00 * c0)
-        } else {
-            let (a0, a1) = (inv00 * c0 + inv01 * c1, inv01 * c0 + inv11 * c1);
-            g0 * a0 + g1 * a1
-        };
-        rows.contacts[i] = contacts;
+        dropped += eliminate_at_node(contacts);
+        let contacts = *contacts;
         // The segments through node i: i − 1 (node i is its second) and i (its first).
         let through = [(i.wrapping_sub(1), 1), (i, 0)];
         for (segment, block) in through {
@@ -123,18 +107,51 @@ pub fn eliminate_contacts<const N: usize>(rows: &mut Rows<N>, nodes: usize) -> u
                 continue;
             }
             if let Some(row) = rows.rows.get_mut(usize::from(r)) {
-                let g = row.gradient_at(block);
-                row.rhs -= g.dot(contacts.displacement);
-                let along = if single {
-                    g0 * (inv00 * g0.dot(g))
-                } else {
-                    project_onto_normals(&contacts, g)
-                };
-                row.projected[block] = g - along;
+                row.projected[block] =
+                    eliminate_from_segment(&contacts, row.gradient_at(block), &mut row.rhs);
             }
         }
     }
     dropped
+}
+
+/// The first half of [`eliminate_contacts`] at one node: the inverse Gram matrix of its
+/// collision rows (`kept`) and its displacement `d = G (GᵀG)⁻¹ C_G`. A node without rows gets
+/// `kept = 0`. Returns the rows dropped.
+#[inline(always)]
+pub fn eliminate_at_node(contacts: &mut NodeContacts) -> u32 {
+    if contacts.count == 0 {
+        contacts.kept = 0;
+        return 0;
+    }
+    let dropped = gram_inverse(contacts);
+    let [c0, c1] = contacts.value;
+    let [inv00, inv01, inv11] = contacts.inverse_gram;
+    let [g0, g1] = contacts.gradient;
+    // One kept row (nearly every contact): `P v = g (g·v)/(g·g)`, the two-row formulas
+    // without their zero terms.
+    contacts.displacement = if contacts.kept <= 1 {
+        g0 * (inv00 * c0)
+    } else {
+        let (a0, a1) = (inv00 * c0 + inv01 * c1, inv01 * c0 + inv11 * c1);
+        g0 * a0 + g1 * a1
+    };
+    dropped
+}
+
+/// The second half of [`eliminate_contacts`] on one segment through the node of `contacts`,
+/// whose gradient block there is `g`: its right-hand side loses `g·d`; returns the block
+/// projected onto the contacts' tangent space, `(I − P) g`.
+#[inline(always)]
+pub fn eliminate_from_segment(contacts: &NodeContacts, g: Vec3, rhs: &mut Real) -> Vec3 {
+    *rhs -= g.dot(contacts.displacement);
+    let along = if contacts.kept <= 1 {
+        let g0 = contacts.gradient[0];
+        g0 * (contacts.inverse_gram[0] * g0.dot(g))
+    } else {
+        project_onto_normals(contacts, g)
+    };
+    g - along
 }
 
 /// Undoes [`eliminate_contacts`] on the segment rows (`rhs = C`, `projected = ∇C`), so that

@@ -307,7 +307,7 @@ impl<const N: usize> Rows<N> {
     /// Adds the segment from `a` to `b` with `C = value` (rest length² `rest2`) to the
     /// residual and the convergence test.
     #[inline(always)]
-    fn meet(&mut self, value: Real, rest2: Real, tolerance: Real, a: Vec3, b: Vec3) {
+    pub(crate) fn meet(&mut self, value: Real, rest2: Real, tolerance: Real, a: Vec3, b: Vec3) {
         // `max` would drop a NaN: keep it visible in the residual. Compared multiplied out,
         // so the division runs only for a new largest row (a few per iterate, not one per
         // segment: VDIV is 14 cycles on a Cortex-M4F).
@@ -341,6 +341,18 @@ pub struct ContactMemory<const N: usize> {
     pub touched: [u8; N],
     /// `Λ` of each node's row for each collider, summed over iterations (< 0: pushing out).
     pub multipliers: [[Real; MAX_COLLIDERS]; N],
+}
+
+impl<const N: usize> ContactMemory<N> {
+    /// Back to [`Default`], in place: only the nodes that touched had multipliers.
+    pub fn forget(&mut self) {
+        for (touched, sums) in self.touched.iter_mut().zip(self.multipliers.iter_mut()) {
+            if *touched != 0 {
+                *touched = 0;
+                *sums = [0.0; MAX_COLLIDERS];
+            }
+        }
+    }
 }
 
 impl<const N: usize> Default for ContactMemory<N> {
@@ -431,17 +443,19 @@ pub fn evaluate<M: Math, const N: usize>(
     memory: &mut ContactMemory<N>,
     rows: &mut Rows<N>,
 ) {
-    rows.count = 0;
-    rows.residual = 0.0;
-    rows.converged = true;
-    rows.max_depth = 0.0;
-    rows.truncated = false;
-    rows.tentative = false;
+    let x = &strand.state.position;
+    let at = |i: usize| x[i];
+    let rest_length = &strand.rest.segment_length;
+    let found = (memory, &mut *rows);
+    evaluate_contacts::<M, N>(
+        (at, rest_length),
+        nodes,
+        colliders,
+        layout,
+        tolerance,
+        found,
+    );
     let count = nodes.count.min(N);
-    // Without collision slots no node ever gets a contact (counts stay 0 from `Default`).
-    if layout.contact_slots > 0 {
-        detect_contacts::<M, N>(strand, nodes, colliders, layout, tolerance, memory, rows);
-    }
     // Contacts first, then segments: the residual is a maximum, the convergence test a
     // conjunction, so the order changes neither (a NaN segment value now always stays
     // visible in the residual, where a later contact's `max` could hide it before).
@@ -451,6 +465,32 @@ pub fn evaluate<M: Math, const N: usize>(
         for (r, first) in rows.first.iter_mut().enumerate().take(rows.count) {
             *first = r.saturating_sub(1) as u16;
         }
+    }
+}
+
+/// The first half of [`evaluate`]: forgets the last iterate's rows, then finds the contacts
+/// of the nodes at `position(i)` (`rest_length` per segment) into `rows`, with their share of
+/// the residual. [`evaluate`] lays the segments out after it; the projection of a block in
+/// lanes lays them out in lanes.
+#[inline(always)]
+pub fn evaluate_contacts<M: Math, const N: usize>(
+    (position, rest_length): (impl Fn(usize) -> Vec3, &[Real; N]),
+    nodes: &Nodes<N>,
+    colliders: &[(u8, Shape)],
+    layout: Layout,
+    tolerance: Real,
+    (memory, rows): (&mut ContactMemory<N>, &mut Rows<N>),
+) {
+    rows.count = 0;
+    rows.residual = 0.0;
+    rows.converged = true;
+    rows.max_depth = 0.0;
+    rows.truncated = false;
+    rows.tentative = false;
+    // Without collision slots no node ever gets a contact (counts stay 0 from `Default`).
+    if layout.contact_slots > 0 {
+        let at = (position, rest_length);
+        detect_contacts::<M, N>(at, nodes, colliders, layout, tolerance, memory, rows);
     }
 }
 
@@ -516,7 +556,7 @@ fn beyond(shape: &Shape, p: Vec3, margin: Real) -> bool {
 /// at a time over the nodes, so that the common case — a node far from it — is a
 /// squared-distance test in a tight loop; each node still gets its rows in collider order.
 fn detect_contacts<M: Math, const N: usize>(
-    strand: &Strand<N>,
+    (x, rest_length): (impl Fn(usize) -> Vec3, &[Real; N]),
     nodes: &Nodes<N>,
     colliders: &[(u8, Shape)],
     layout: Layout,
@@ -524,8 +564,6 @@ fn detect_contacts<M: Math, const N: usize>(
     memory: &mut ContactMemory<N>,
     rows: &mut Rows<N>,
 ) {
-    let x = &strand.state.position;
-    let rest_length = &strand.rest.segment_length;
     let count = nodes.count.min(N);
     rows.forget_contacts();
     let margin_fraction = if layout.contact_margin && !layout.residual_only {
@@ -541,8 +579,9 @@ fn detect_contacts<M: Math, const N: usize>(
             let free = nodes.is_free(i);
             // Test the bit first: most nodes never touch anything.
             let remembered = memory.touched[i] & bit != 0;
+            let p = x(i);
             let margin = margin_fraction * rest_length[i - 1];
-            if !free || (!remembered && beyond(shape, x[i], margin)) {
+            if !free || (!remembered && beyond(shape, p, margin)) {
                 continue;
             }
             let sticky = remembered
@@ -550,17 +589,17 @@ fn detect_contacts<M: Math, const N: usize>(
                     .get(usize::from(c))
                     .is_some_and(|&lambda| lambda < 0.0);
             let found = if sticky {
-                Some(surface::<M>(shape, x[i]))
+                Some(surface::<M>(shape, p))
             } else if margin > 0.0 {
-                near_surface::<M>(shape, x[i], margin)
+                near_surface::<M>(shape, p, margin)
             } else {
-                shape.penetration::<M>(x[i]).map(|c| (c.normal, c.depth))
+                shape.penetration::<M>(p).map(|c| (c.normal, c.depth))
             };
             let Some((normal, depth)) = found else {
                 continue;
             };
             if depth > 0.0 {
-                rows.meet_contact(depth, rest_length[i - 1], tolerance, shape, x[i]);
+                rows.meet_contact(depth, rest_length[i - 1], tolerance, shape, p);
             }
             let found = Found {
                 node: i,

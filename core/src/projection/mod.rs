@@ -33,6 +33,7 @@
 
 pub mod banded;
 pub mod constraints;
+pub mod lanes;
 
 use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
@@ -126,8 +127,43 @@ pub fn project_constraints<M: Math, const N: usize>(
     let mut work = Workspace::new(strand, n);
     prescribe_grabs(strand, grabs, &held, &mut work.nodes);
     let (shapes, shape_count) = usable_colliders(ctx);
-    let layout = Layout {
-        inextensibility,
+    let layout = layout_of(ctx, shape_count);
+    let shapes = shapes.get(..shape_count).unwrap_or(&[]);
+    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    let findings = Findings {
+        touched: &work.contacts.touched,
+        max_depth: work.rows.max_depth,
+        truncated: work.truncated,
+        collider_push: &work.collider_push,
+    };
+    let outcome = conclude::<M, N>(strand, &work.predicted, ctx, outcome, findings, report);
+    record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
+    outcome
+}
+
+/// The end of a projection from the positions `predicted`: positions kept finite, the
+/// velocity update, the report.
+fn conclude<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    predicted: &[Vec3; N],
+    ctx: &StepContext,
+    mut outcome: Outcome,
+    findings: Findings<'_, N>,
+    report: &mut StepReport,
+) -> Outcome {
+    let n = strand.rest.nodes.min(N);
+    keep_finite(strand, predicted, n, ctx.inv_dt, &mut outcome);
+    report.ran(Stage::Velocity);
+    update_velocities(strand, predicted, ctx.inv_dt);
+    record::<M, N>(strand, ctx, &outcome, findings, report);
+    outcome
+}
+
+/// The rows the step's effects ask for, with `shape_count` usable colliders.
+fn layout_of(ctx: &StepContext, shape_count: usize) -> Layout {
+    let collisions = ctx.has(Effect::Collisions);
+    Layout {
+        inextensibility: ctx.has(Effect::Inextensibility),
         contact_slots: if collisions {
             shape_count.min(MAX_NODE_CONTACTS)
         } else {
@@ -138,15 +174,42 @@ pub fn project_constraints<M: Math, const N: usize>(
         // keeps one solve per iteration.
         contact_margin: collisions && ctx.params.mode == Mode::Converge,
         residual_only: false,
-    };
-    let shapes = shapes.get(..shape_count).unwrap_or(&[]);
-    let mut outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
-    keep_finite(strand, &work, n, ctx.inv_dt, &mut outcome);
-    report.ran(Stage::Velocity);
-    update_velocities(strand, &work.predicted, ctx.inv_dt);
-    record::<M, N>(strand, ctx, &outcome, &work, report);
-    record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
-    outcome
+    }
+}
+
+/// The projection's inverse masses of `strand`'s first `n` nodes: nodes 0 and 1 follow the
+/// head (root coupling), prescribed, infinite mass; so is a node of no finite positive mass.
+#[inline(always)]
+fn free_nodes<const N: usize>(strand: &Strand<N>, n: usize) -> Nodes<N> {
+    let mut inverse_mass = [0.0; N];
+    for (i, (w, &rest)) in inverse_mass
+        .iter_mut()
+        .zip(strand.rest.inverse_mass.iter())
+        .enumerate()
+        .take(n)
+    {
+        *w = if i >= 2 && rest > 0.0 && rest.is_finite() {
+            rest
+        } else {
+            0.0
+        };
+    }
+    Nodes {
+        inverse_mass,
+        count: n,
+    }
+}
+
+/// The longest move of a node in one iteration: [`TRUST_RADIUS_IN_STRAND_LENGTHS`] times the
+/// rest length of `strand`'s first `n` nodes.
+fn trust_radius<const N: usize>(strand: &Strand<N>, n: usize) -> Real {
+    TRUST_RADIUS_IN_STRAND_LENGTHS
+        * strand
+            .rest
+            .segment_length
+            .iter()
+            .take(n.saturating_sub(1))
+            .sum::<Real>()
 }
 
 /// Finite in, finite out: if a degenerate configuration (found by the fuzz target: a capsule,
@@ -156,7 +219,7 @@ pub fn project_constraints<M: Math, const N: usize>(
 /// "Overflowed" includes a finite move so large that the velocity update `Δx/h` would not be.
 fn keep_finite<const N: usize>(
     strand: &mut Strand<N>,
-    work: &Workspace<N>,
+    predicted: &[Vec3; N],
     n: usize,
     inv_dt: Real,
     outcome: &mut Outcome,
@@ -164,13 +227,13 @@ fn keep_finite<const N: usize>(
     let position = &mut strand.state.position;
     let finite = position
         .iter()
-        .zip(work.predicted.iter())
+        .zip(predicted.iter())
         .take(n)
         .all(|(x, p)| crate::math::is_finite((*x - *p) * inv_dt));
     if finite {
         return;
     }
-    *position = work.predicted;
+    *position = *predicted;
     outcome.converged = false;
     outcome.dropped_rows += 1;
     let mut residual: Real = 0.0;
@@ -193,39 +256,16 @@ impl<const N: usize> Workspace<N> {
     // Cortex-M4F the copies were a fifth of the projection's zero fills and copies).
     #[inline(always)]
     fn new(strand: &Strand<N>, n: usize) -> Self {
-        let mut inverse_mass = [0.0; N];
-        for (i, (w, &rest)) in inverse_mass
-            .iter_mut()
-            .zip(strand.rest.inverse_mass.iter())
-            .enumerate()
-            .take(n)
-        {
-            // Nodes 0 and 1 follow the head (root coupling): prescribed, infinite mass.
-            *w = if i >= 2 && rest > 0.0 && rest.is_finite() {
-                rest
-            } else {
-                0.0
-            };
-        }
         Workspace {
             predicted: strand.state.position,
-            nodes: Nodes {
-                inverse_mass,
-                count: n,
-            },
+            nodes: free_nodes(strand, n),
             contacts: ContactMemory::default(),
             rows: Rows::default(),
             band: [[0.0; banded::MAX_HALF_BANDWIDTH + 1]; N],
             multipliers: [0.0; N],
             grab_pull: [Vec3::ZERO; MAX_GRABS],
             step: [Vec3::ZERO; N],
-            trust_radius: TRUST_RADIUS_IN_STRAND_LENGTHS
-                * strand
-                    .rest
-                    .segment_length
-                    .iter()
-                    .take(n.saturating_sub(1))
-                    .sum::<Real>(),
+            trust_radius: trust_radius(strand, n),
             collider_push: [Vec3::ZERO; MAX_COLLIDERS],
             truncated: false,
         }
@@ -234,7 +274,7 @@ impl<const N: usize> Workspace<N> {
 
 /// The step's colliders that pass their checks (a bad one can come through `step_strands`),
 /// each with its index in the step's list, packed at the front.
-fn usable_colliders(ctx: &StepContext) -> ([(u8, Shape); MAX_COLLIDERS], usize) {
+pub(crate) fn usable_colliders(ctx: &StepContext) -> ([(u8, Shape); MAX_COLLIDERS], usize) {
     let placeholder = Shape::Plane {
         point: Vec3::ZERO,
         normal: Vec3::Y,
@@ -332,7 +372,7 @@ fn iterate<M: Math, const N: usize>(
 /// inside it: its per-node test would find nothing, so skipping it changes no bit. The grown
 /// boxes only grow, so the near set only grows: a node that got a collision row keeps its
 /// collider in the set (and so its sticky row, see [`constraints::evaluate`]).
-struct NearColliders {
+pub(crate) struct NearColliders {
     /// Smallest and largest coordinates of the free nodes at the start.
     low: Vec3,
     high: Vec3,
@@ -352,7 +392,7 @@ struct NearColliders {
 }
 
 impl NearColliders {
-    fn new<const N: usize>(
+    pub(crate) fn new<const N: usize>(
         strand: &Strand<N>,
         nodes: &constraints::Nodes<N>,
         shapes: &[(u8, Shape)],
@@ -392,9 +432,28 @@ impl NearColliders {
         }
     }
 
+    /// No collider near: for a scratch space before its first use.
+    pub(crate) fn none() -> Self {
+        let placeholder = Shape::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        NearColliders {
+            low: Vec3::ZERO,
+            high: Vec3::ZERO,
+            rounding: 0.0,
+            grown: 0.0,
+            free: false,
+            bounded: false,
+            mask: 0,
+            near: [(0, placeholder); MAX_COLLIDERS],
+            count: 0,
+        }
+    }
+
     /// Adds an iteration's longest move (squared, before any trust-region scaling: an upper
     /// bound of the move made).
-    fn moved<M: Math>(&mut self, longest2: Real) {
+    pub(crate) fn moved<M: Math>(&mut self, longest2: Real) {
         if self.bounded {
             self.grown += M::sqrt(longest2);
             self.bounded = self.grown.is_finite();
@@ -402,7 +461,7 @@ impl NearColliders {
     }
 
     /// The colliders that may hold a free node at this iterate, in the step's order.
-    fn shapes<'a>(&'a mut self, shapes: &'a [(u8, Shape)]) -> &'a [(u8, Shape)] {
+    pub(crate) fn shapes<'a>(&'a mut self, shapes: &'a [(u8, Shape)]) -> &'a [(u8, Shape)] {
         if !self.free {
             return &[];
         }
@@ -545,7 +604,7 @@ fn solve_and_move<M: Math, const N: usize>(
     }
     pull_on_grabs(work, held, count, scale);
     if any_contact {
-        push_on_colliders(work, count, n, scale);
+        push_on_colliders_alone(work, count, n, scale);
     }
     Some((dropped, longest2))
 }
@@ -559,7 +618,7 @@ fn solve_and_move<M: Math, const N: usize>(
 /// ones converged; a radius of one strand length cut that short and broke the iteration.
 /// Hence ten strand lengths ([`TRUST_RADIUS_IN_STRAND_LENGTHS`]).
 #[inline(always)]
-fn trust_scale<M: Math>(longest2: Real, bound: Real) -> Real {
+pub(crate) fn trust_scale<M: Math>(longest2: Real, bound: Real) -> Real {
     if longest2 > bound * bound {
         bound / M::sqrt(longest2)
     } else {
@@ -588,7 +647,8 @@ fn solve<const N: usize>(work: &mut Workspace<N>, n: usize, count: usize) -> Opt
         }
         let all = pass >= 2;
         let inverse_mass = &work.nodes.inverse_mass;
-        if !prune_tentative(&mut work.rows, multipliers, inverse_mass, n, all) {
+        let pull = |rows: &Rows<N>, i| segment_pull_on_node(rows, multipliers, i);
+        if !prune_tentative(&mut work.rows, inverse_mass, n, all, pull) {
             break;
         }
         banded::undo_elimination(&mut work.rows);
@@ -621,39 +681,58 @@ fn pull_on_grabs<const N: usize>(
     }
 }
 
-/// Each collider's share of the multipliers actually applied (`scale · δλ`), from the nodes
-/// that kept a contact row this iteration: its push (`work.collider_push`), each node's summed
-/// multiplier per collider, and the node marked as touching it (a tentative row that stayed
-/// pushes: a contact from now on).
-#[inline(always)]
-fn push_on_colliders<const N: usize>(work: &mut Workspace<N>, count: usize, n: usize, scale: Real) {
+/// [`push_on_colliders`] of one strand's workspace.
+fn push_on_colliders_alone<const N: usize>(
+    work: &mut Workspace<N>,
+    count: usize,
+    n: usize,
+    scale: Real,
+) {
     let multipliers = work.multipliers.get(..count).unwrap_or(&[]);
-    for k in 0..work.rows.contact_count.min(N) {
-        let i = usize::from(work.rows.contact_nodes[k]);
-        let Some(&contacts) = work.rows.contacts.get(i) else {
+    let pull = |rows: &Rows<N>, i| segment_pull_on_node(rows, multipliers, i);
+    let memory = (&mut work.contacts, &mut work.collider_push);
+    push_on_colliders(&work.rows, memory, &work.nodes.inverse_mass, n, scale, pull);
+}
+
+/// Each collider's share of the multipliers actually applied (`scale · δλ`), from the nodes
+/// that kept a contact row this iteration: its push (`collider_push`), each node's summed
+/// multiplier per collider, and the node marked as touching it (a tentative row that stayed
+/// pushes: a contact from now on). `segment_pull(rows, i)` is `Σ_s ∇_{x_i}C_s δλ_s` over the
+/// segments through node `i` ([`segment_pull_on_node`] for one strand).
+#[inline(always)]
+pub(crate) fn push_on_colliders<const N: usize>(
+    rows: &Rows<N>,
+    (memory, collider_push): (&mut ContactMemory<N>, &mut [Vec3; MAX_COLLIDERS]),
+    inverse_mass: &[Real; N],
+    n: usize,
+    scale: Real,
+    segment_pull: impl Fn(&Rows<N>, usize) -> Vec3,
+) {
+    for k in 0..rows.contact_count.min(N) {
+        let i = usize::from(rows.contact_nodes[k]);
+        let Some(&contacts) = rows.contacts.get(i) else {
             continue;
         };
         if contacts.kept == 0 || i >= n {
             continue;
         }
-        let segment_pull = segment_pull_on_node(&work.rows, multipliers, i);
-        let w = work.nodes.inverse_mass[i];
-        let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
+        let lambdas =
+            banded::contact_multipliers(&contacts, inverse_mass[i], segment_pull(rows, i));
         let kept = usize::from(contacts.kept);
-        let rows = contacts
+        let each = contacts
             .collider
             .iter()
             .zip(contacts.gradient.iter())
             .zip(lambdas.iter());
-        for ((&c, &gradient), &lambda) in rows.take(kept) {
+        for ((&c, &gradient), &lambda) in each.take(kept) {
             let c = usize::from(c);
-            if let Some(push) = work.collider_push.get_mut(c) {
+            if let Some(push) = collider_push.get_mut(c) {
                 *push += gradient * (lambda * scale);
             }
-            if let Some(sum) = work.contacts.multipliers[i].get_mut(c) {
+            if let Some(sum) = memory.multipliers[i].get_mut(c) {
                 *sum += lambda * scale;
             }
-            work.contacts.touched[i] |= 1 << (c % 8);
+            memory.touched[i] |= 1 << (c % 8);
         }
     }
 }
@@ -662,12 +741,12 @@ fn push_on_colliders<const N: usize>(work: &mut Workspace<N>, count: usize, n: u
 /// would hold its node at the surface against the segments pulling it away), or every
 /// tentative row when `all`. Returns whether any row was removed (the system must be solved
 /// again); `rows.tentative` then says whether tentative rows are left.
-fn prune_tentative<const N: usize>(
+pub(crate) fn prune_tentative<const N: usize>(
     rows: &mut Rows<N>,
-    multipliers: &[Real],
     inverse_mass: &[Real; N],
     n: usize,
     all: bool,
+    segment_pull: impl Fn(&Rows<N>, usize) -> Vec3,
 ) -> bool {
     let mut removed = false;
     let mut left = false;
@@ -681,8 +760,7 @@ fn prune_tentative<const N: usize>(
         }
         let mut pulling = contacts.tentative;
         if !all {
-            let segment_pull = segment_pull_on_node(rows, multipliers, i);
-            let lambdas = banded::contact_multipliers(&contacts, w, segment_pull);
+            let lambdas = banded::contact_multipliers(&contacts, w, segment_pull(rows, i));
             for (k, &lambda) in lambdas.iter().enumerate() {
                 if lambda < 0.0 {
                     pulling &= !(1 << k);
@@ -731,12 +809,24 @@ fn update_velocities<const N: usize>(strand: &mut Strand<N>, predicted: &[Vec3; 
     }
 }
 
+/// What a projection found besides its [`Outcome`], for the report.
+pub(crate) struct Findings<'a, const N: usize> {
+    /// Per node, the colliders it touched (bit `c`).
+    pub touched: &'a [u8; N],
+    /// The deepest penetration at the last evaluation, m.
+    pub max_depth: Real,
+    /// Whether a node had more contacts than its slots.
+    pub truncated: bool,
+    /// Each collider's push, × h².
+    pub collider_push: &'a [Vec3; MAX_COLLIDERS],
+}
+
 /// Iterations, residual, flags, stretch, contacts and collider forces into the report.
 fn record<M: Math, const N: usize>(
     strand: &Strand<N>,
     ctx: &StepContext,
     outcome: &Outcome,
-    work: &Workspace<N>,
+    work: Findings<'_, N>,
     report: &mut StepReport,
 ) {
     report.iterations_max = report.iterations_max.max(outcome.iterations);
@@ -756,28 +846,26 @@ fn record<M: Math, const N: usize>(
     if work.truncated {
         report.flags.insert(Flags::CONTACTS_TRUNCATED);
     }
-    report.max_penetration = report.max_penetration.max(work.rows.max_depth);
+    report.max_penetration = report.max_penetration.max(work.max_depth);
     let n = strand.rest.nodes.min(N);
     let x = &strand.state.position;
     for j in 0..n.saturating_sub(1) {
         let rest = strand.rest.segment_length[j];
         let e = x[j + 1] - x[j];
         let stretch = (M::length(e) - rest).abs() / rest;
-        if work.contacts.touched[j] != 0 || work.contacts.touched[j + 1] != 0 {
+        if work.touched[j] != 0 || work.touched[j + 1] != 0 {
             report.max_contact_stretch = report.max_contact_stretch.max(stretch);
         } else {
             report.max_stretch = report.max_stretch.max(stretch);
         }
     }
-    report.contacts += work
-        .contacts
-        .touched
-        .iter()
-        .take(n)
-        .filter(|&&t| t != 0)
-        .count() as u32;
+    report.contacts += work.touched.iter().take(n).filter(|&&t| t != 0).count() as u32;
     let inv_h2 = ctx.inv_dt * ctx.inv_dt;
-    for (force, push) in report.collider_forces.iter_mut().zip(work.collider_push) {
+    for (force, push) in report
+        .collider_forces
+        .iter_mut()
+        .zip(work.collider_push.iter())
+    {
         *force += push * inv_h2;
     }
 }

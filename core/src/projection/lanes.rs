@@ -1,0 +1,542 @@
+//! The fast manifold projection (Kmoch 2009 Sec. 8) of a block's strands in lanes
+//! (`lane::Wide`), one strand per lane: the segment rows, their banded `L D Lᵀ` and the moves
+//! of `W` strands at once. Each lane's contacts are found, eliminated at their nodes and
+//! pruned strand by strand, through the very functions [`super::project_constraints`] calls
+//! (few nodes touch a collider, and each touches its own way). Every lane takes the
+//! operations its strand takes alone, in the same order, and a lane that has converged or
+//! failed keeps still while the others iterate: each strand gets the bits it gets alone.
+//!
+//! The lanes take strands whose rows are laid out alike: inextensibility on, every node past
+//! the root's two free (no grab holds one), the same node count, three nodes or more. Then
+//! segment `j ≥ 1` is row `j − 1`, coupled to the row before it, and segment 0, between the
+//! two prescribed root nodes, has none.
+
+use crate::collide::{Shape, MAX_COLLIDERS};
+use crate::context::StepContext;
+use crate::effects::Effect;
+use crate::grab::{grabbed_nodes, Grab};
+use crate::lane::{Wide, WideMask, V3};
+use crate::math::{Math, Real, Vec3};
+use crate::params::Mode;
+use crate::report::{Stage, StepReport};
+use crate::strand::Strand;
+
+use super::banded::{eliminate_at_node, eliminate_from_segment, PIVOT_RATIO};
+use super::constraints::{evaluate_contacts, ContactMemory, Layout, Nodes, Rows};
+use super::{
+    conclude, free_nodes, layout_of, prune_tentative, push_on_colliders, trust_radius, trust_scale,
+    usable_colliders, Findings, NearColliders, Outcome,
+};
+
+/// Whether strand `strand` (index `index` in the scene) can be projected in lanes with
+/// strands of `nodes` nodes: see the module documentation.
+#[must_use]
+pub fn fits_lanes<const N: usize>(
+    strand: &Strand<N>,
+    ctx: &StepContext,
+    grabs: &[Grab],
+    index: u32,
+    nodes: usize,
+) -> bool {
+    let n = strand.rest.nodes.min(N);
+    let free = strand.rest.inverse_mass.iter().take(n).skip(2);
+    n == nodes
+        && n >= 3
+        && ctx.has(Effect::Inextensibility)
+        && free.clone().all(|&w| w > 0.0 && w.is_finite())
+        && grabbed_nodes(ctx, grabs, index, n).is_empty()
+}
+
+/// One lane's bookkeeping: what [`super::project_constraints`] keeps for its strand besides
+/// the segment rows.
+struct Lane<const N: usize> {
+    nodes: Nodes<N>,
+    /// The contacts (the segment rows live in the lanes).
+    rows: Rows<N>,
+    contacts: ContactMemory<N>,
+    collider_push: [Vec3; MAX_COLLIDERS],
+    near: NearColliders,
+    outcome: Outcome,
+    truncated: bool,
+    trust_radius: Real,
+    /// Still iterating.
+    running: bool,
+}
+
+/// The projection of up to `W` strands in lanes: run by [`BlockProjection::run`], then each
+/// strand's result taken in scene order by [`BlockProjection::finish`].
+pub struct BlockProjection<const N: usize, const W: usize> {
+    taken: [bool; W],
+    nodes: usize,
+    position: [V3<Wide<W>>; N],
+    inverse_mass: [Wide<W>; N],
+    /// `ê^j·ê^j` per segment.
+    rest_squared: [Wide<W>; N],
+    /// Row `r` (segment `r + 1`): `C`, the right-hand side after the contacts' elimination,
+    /// `∇C` at the segment's second node, and the blocks at its two nodes after it.
+    value: [Wide<W>; N],
+    rhs: [Wide<W>; N],
+    gradient: [V3<Wide<W>>; N],
+    projected: [[V3<Wide<W>>; 2]; N],
+    multipliers: [Wide<W>; N],
+    step: [V3<Wide<W>>; N],
+    lanes: [Lane<N>; W],
+}
+
+impl<const N: usize, const W: usize> Default for BlockProjection<N, W> {
+    fn default() -> Self {
+        let zero = Wide([0.0; W]);
+        BlockProjection {
+            taken: [false; W],
+            nodes: 0,
+            position: [V3::zero(); N],
+            inverse_mass: [zero; N],
+            rest_squared: [zero; N],
+            value: [zero; N],
+            rhs: [zero; N],
+            gradient: [V3::zero(); N],
+            projected: [[V3::zero(); 2]; N],
+            multipliers: [zero; N],
+            step: [V3::zero(); N],
+            lanes: core::array::from_fn(|_| Lane {
+                nodes: Nodes {
+                    inverse_mass: [0.0; N],
+                    count: 0,
+                },
+                rows: Rows::default(),
+                contacts: ContactMemory::default(),
+                collider_push: [Vec3::ZERO; MAX_COLLIDERS],
+                near: NearColliders::none(),
+                outcome: Outcome::default(),
+                truncated: false,
+                trust_radius: 0.0,
+                running: false,
+            }),
+        }
+    }
+}
+
+impl<const N: usize, const W: usize> BlockProjection<N, W> {
+    /// Projects the strands `taken` names (each [`fits_lanes`]) in lanes, in this scratch
+    /// space (made once for many blocks: it is large); `false` if it names none. The strands
+    /// keep their positions until [`Self::finish`].
+    pub fn run<M: Math>(
+        &mut self,
+        strands: &[Strand<N>],
+        taken: &[bool; W],
+        ctx: &StepContext,
+    ) -> bool {
+        let Some(lead) = taken.iter().position(|&t| t).and_then(|f| strands.get(f)) else {
+            return false;
+        };
+        self.taken = core::array::from_fn(|l| taken[l] && l < strands.len());
+        // A lane left out computes a copy of the first strand taken, never read.
+        let taken = self.taken;
+        let source = |l: usize| strands.get(l).filter(|_| taken[l]).unwrap_or(lead);
+        let nodes = lead.rest.nodes.min(N);
+        self.nodes = nodes;
+        let (shapes, shape_count) = usable_colliders(ctx);
+        let shapes = shapes.get(..shape_count).unwrap_or(&[]);
+        let layout = layout_of(ctx, shape_count);
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            let strand = source(l);
+            book.nodes = free_nodes(strand, nodes);
+            book.near = NearColliders::new(strand, &book.nodes, shapes, layout.contact_slots > 0);
+            book.contacts.forget();
+            book.collider_push = [Vec3::ZERO; MAX_COLLIDERS];
+            book.outcome = Outcome::default();
+            book.truncated = false;
+            book.trust_radius = trust_radius(strand, nodes);
+            book.running = taken[l];
+            for i in 0..nodes {
+                self.position[i].set_lane(l, strand.state.position[i]);
+                self.inverse_mass[i].0[l] = book.nodes.inverse_mass[i];
+                let rest = strand.rest.segment_length[i];
+                self.rest_squared[i].0[l] = rest * rest;
+            }
+        }
+        self.iterate::<M>(strands, ctx, shapes, layout);
+        true
+    }
+
+    /// Lane `lane`'s strand takes its projected positions, keeps them finite, updates its
+    /// velocities and reports, as [`super::project_constraints`] ends.
+    pub fn finish<M: Math>(
+        &self,
+        lane: usize,
+        strand: &mut Strand<N>,
+        ctx: &StepContext,
+        report: &mut StepReport,
+    ) -> Outcome {
+        let Some(book) = self.lanes.get(lane).filter(|_| self.taken[lane]) else {
+            return Outcome::default();
+        };
+        report.ran(Stage::Projection);
+        if ctx.has(Effect::Collisions) {
+            report.ran(Stage::Collisions);
+        }
+        let n = self.nodes;
+        let predicted = strand.state.position;
+        for (x, lanes) in strand.state.position.iter_mut().zip(&self.position).take(n) {
+            *x = lanes.lane(lane);
+        }
+        let findings = Findings {
+            touched: &book.contacts.touched,
+            max_depth: book.rows.max_depth,
+            truncated: book.truncated,
+            collider_push: &book.collider_push,
+        };
+        conclude::<M, N>(strand, &predicted, ctx, book.outcome, findings, report)
+    }
+
+    /// `super::iterate` in lanes: evaluate, test, solve, move, each lane until it stops.
+    fn iterate<M: Math>(
+        &mut self,
+        strands: &[Strand<N>],
+        ctx: &StepContext,
+        shapes: &[(u8, Shape)],
+        layout: Layout,
+    ) {
+        let cap = u32::from(ctx.params.rod.projection_iterations);
+        let tolerance = ctx.params.rod.projection_tolerance;
+        let fixed_cost = ctx.params.mode == Mode::FixedCost;
+        for k in 0..=cap {
+            // After the last solve only the residual is wanted: no rows.
+            let layout = Layout {
+                residual_only: k == cap,
+                ..layout
+            };
+            self.evaluate::<M>(strands, shapes, layout, tolerance);
+            let mut any = false;
+            for book in self.lanes.iter_mut().filter(|b| b.running) {
+                book.truncated |= book.rows.truncated;
+                book.outcome.residual = book.rows.residual;
+                book.outcome.converged = book.rows.converged;
+                book.running = !(k == cap || (book.outcome.converged && !fixed_cost));
+                any |= book.running;
+            }
+            if !any {
+                break;
+            }
+            self.solve_and_move::<M>();
+        }
+    }
+
+    /// `constraints::evaluate` in lanes: each running lane's contacts, then the segment rows
+    /// of all lanes and their share of each running lane's residual.
+    fn evaluate<M: Math>(
+        &mut self,
+        strands: &[Strand<N>],
+        shapes: &[(u8, Shape)],
+        layout: Layout,
+        tolerance: Real,
+    ) {
+        let position = &self.position;
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            let Some(strand) = strands.get(l).filter(|_| book.running) else {
+                continue;
+            };
+            let at = |i: usize| position[i].lane(l);
+            let rest_length = &strand.rest.segment_length;
+            let near = book.near.shapes(shapes);
+            let found = (&mut book.contacts, &mut book.rows);
+            let nodes = &book.nodes;
+            evaluate_contacts::<M, N>((at, rest_length), nodes, near, layout, tolerance, found);
+        }
+        let two = Wide([2.0; W]);
+        for j in 1..self.nodes.saturating_sub(1) {
+            let (a, b) = (self.position[j], self.position[j + 1]);
+            let e = b - a;
+            let rest2 = self.rest_squared[j];
+            let value = e.dot(e) - rest2;
+            if !layout.residual_only {
+                let r = j - 1;
+                let gradient = e * two;
+                self.value[r] = value;
+                self.rhs[r] = value;
+                self.gradient[r] = gradient;
+                self.projected[r] = [-gradient, gradient];
+            }
+            for (l, book) in self.lanes.iter_mut().enumerate() {
+                if book.running {
+                    let (a, b) = (a.lane(l), b.lane(l));
+                    book.rows.meet(value.0[l], rest2.0[l], tolerance, a, b);
+                }
+            }
+        }
+    }
+
+    /// `super::solve_and_move` in lanes: the multipliers, then each running lane's move
+    /// (within its trust radius) and its contacts' push; a lane whose multipliers or moves are
+    /// not finite stops where it is.
+    fn solve_and_move<M: Math>(&mut self) {
+        let n = self.nodes;
+        let count = n.saturating_sub(2);
+        let dropped = self.solve();
+        let mut moving = WideMask([false; W]);
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            if !book.running {
+                continue;
+            }
+            let finite = self.multipliers[..count].iter().all(|m| m.0[l].is_finite());
+            if finite {
+                moving.0[l] = true;
+            } else {
+                book.outcome.dropped_rows += 1;
+                book.running = false;
+            }
+        }
+        let (any_contact, longest2) = self.moves(moving);
+        let mut scale = Wide([1.0; W]);
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            if !moving.0[l] {
+                continue;
+            }
+            if longest2[l].is_finite() {
+                scale.0[l] = trust_scale::<M>(longest2[l], book.trust_radius);
+            } else {
+                book.outcome.dropped_rows += 1;
+                book.running = false;
+                moving.0[l] = false;
+            }
+        }
+        for (x, dx) in self.position.iter_mut().zip(&self.step).take(n) {
+            *x = V3::select(moving, *x + *dx * scale, *x);
+        }
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            if !moving.0[l] {
+                continue;
+            }
+            if any_contact[l] {
+                let (gradient, multipliers) = (&self.gradient, &self.multipliers);
+                let pull = |_: &Rows<N>, i| segment_pull(gradient, multipliers, n, i, l);
+                let memory = (&mut book.contacts, &mut book.collider_push);
+                let inverse_mass = &book.nodes.inverse_mass;
+                push_on_colliders(&book.rows, memory, inverse_mass, n, scale.0[l], pull);
+            }
+            book.outcome.dropped_rows += dropped[l];
+            book.near.moved::<M>(longest2[l]);
+            book.outcome.iterations += 1;
+        }
+    }
+
+    /// `Δx` of every node into `step`: from the segments (`−w_i (I − P_i) ∇_iC δλ` over the
+    /// two segments through node `i`, segment `i − 1` first; nodes 0 and 1 are prescribed),
+    /// then in the lanes `moving` names from the node's contacts (`−d_i`). Returns, per lane,
+    /// whether a node moved by its contacts and the longest move (squared).
+    fn moves(&mut self, moving: WideMask<W>) -> ([bool; W], [Real; W]) {
+        self.segment_moves();
+        let n = self.nodes;
+        let mut any_contact = [false; W];
+        for (l, book) in self.lanes.iter().enumerate() {
+            if !moving.0[l] {
+                continue;
+            }
+            for &i in book.rows.contact_nodes() {
+                let i = usize::from(i);
+                let contacts = &book.rows.contacts[i];
+                if contacts.kept > 0 && i < n {
+                    let delta = self.step[i].lane(l) - contacts.displacement;
+                    self.step[i].set_lane(l, delta);
+                    any_contact[l] = true;
+                }
+            }
+        }
+        let mut longest2 = [0.0 as Real; W];
+        for dx in &self.step[..n] {
+            let d2 = dx.dot(*dx);
+            for (longest, &d2) in longest2.iter_mut().zip(d2.0.iter()) {
+                // Not `max`, which would drop a NaN.
+                if d2.is_nan() || d2 > *longest {
+                    *longest = d2;
+                }
+            }
+        }
+        (any_contact, longest2)
+    }
+
+    /// The segments' share of `Δx`.
+    fn segment_moves(&mut self) {
+        let n = self.nodes;
+        for i in 0..n {
+            let mut delta = V3::zero();
+            if i >= 2 {
+                let w = self.inverse_mass[i];
+                delta -= self.projected[i - 2][1] * (w * self.multipliers[i - 2]);
+                if i + 2 <= n {
+                    delta -= self.projected[i - 1][0] * (w * self.multipliers[i - 1]);
+                }
+            }
+            self.step[i] = delta;
+        }
+    }
+
+    /// `super::solve` in lanes: each running lane's contacts eliminated at their nodes, the
+    /// chain solved in lanes, tentative rows that pull removed and the lane solved again.
+    /// Returns each lane's rows dropped at a singular pivot in its last solve.
+    fn solve(&mut self) -> [u32; W] {
+        let n = self.nodes;
+        let mut solving = WideMask(core::array::from_fn(|l| self.lanes[l].running));
+        let mut dropped = [0; W];
+        for pass in 0..4 {
+            for (l, dropped) in dropped.iter_mut().enumerate() {
+                if solving.0[l] {
+                    *dropped = self.eliminate_contacts(l);
+                }
+            }
+            let chain = self.solve_chain(solving);
+            let mut again = false;
+            for (l, dropped) in dropped.iter_mut().enumerate() {
+                if !solving.0[l] {
+                    continue;
+                }
+                *dropped += chain[l];
+                let count = n.saturating_sub(2);
+                let finite = self.multipliers[..count].iter().all(|m| m.0[l].is_finite());
+                let book = &mut self.lanes[l];
+                if !book.rows.tentative || !finite {
+                    solving.0[l] = false;
+                    continue;
+                }
+                let (gradient, multipliers) = (&self.gradient, &self.multipliers);
+                let pull = |_: &Rows<N>, i| segment_pull(gradient, multipliers, n, i, l);
+                let inverse_mass = &book.nodes.inverse_mass;
+                if !prune_tentative(&mut book.rows, inverse_mass, n, pass >= 2, pull) {
+                    solving.0[l] = false;
+                    continue;
+                }
+                self.undo_elimination(l);
+                again = true;
+            }
+            if !again {
+                break;
+            }
+        }
+        dropped
+    }
+
+    /// `banded::eliminate_contacts` on lane `lane`: its contact nodes' collision rows
+    /// eliminated, their effect left on the segment rows through them.
+    fn eliminate_contacts(&mut self, lane: usize) -> u32 {
+        let n = self.nodes;
+        let rows = &mut self.lanes[lane].rows;
+        let mut dropped = 0;
+        for k in 0..rows.contact_count.min(N) {
+            let i = usize::from(rows.contact_nodes[k]);
+            if i >= n {
+                continue;
+            }
+            let Some(contacts) = rows.contacts.get_mut(i) else {
+                continue;
+            };
+            dropped += eliminate_at_node(contacts);
+            // The segments through node i: i − 1 (node i is its second) and i (its first).
+            for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+                if !(1..n.saturating_sub(1)).contains(&segment) {
+                    continue;
+                }
+                let r = segment - 1;
+                let gradient = self.gradient[r].lane(lane);
+                let g = if block == 0 { -gradient } else { gradient };
+                let mut rhs = self.rhs[r].0[lane];
+                let projected = eliminate_from_segment(contacts, g, &mut rhs);
+                self.rhs[r].0[lane] = rhs;
+                self.projected[r][block].set_lane(lane, projected);
+            }
+        }
+        dropped
+    }
+
+    /// `banded::undo_elimination` on lane `lane`.
+    fn undo_elimination(&mut self, lane: usize) {
+        let count = self.nodes.saturating_sub(2);
+        for r in 0..count {
+            self.rhs[r].0[lane] = self.value[r].0[lane];
+            let gradient = self.gradient[r].lane(lane);
+            self.projected[r][0].set_lane(lane, -gradient);
+            self.projected[r][1].set_lane(lane, gradient);
+        }
+    }
+
+    /// `banded::solve_chain` in lanes on the uniform chain (row `r` couples to `r − 1`),
+    /// into the multipliers of the lanes `solving` names. Returns each lane's dropped pivots.
+    fn solve_chain(&mut self, solving: WideMask<W>) -> [u32; W] {
+        let count = self.nodes.saturating_sub(2);
+        let zero = Wide([0.0; W]);
+        let w = &self.inverse_mass;
+        let mut dropped = [0; W];
+        let mut lower = [zero; N];
+        let mut fresh = [zero; N];
+        // D, 1/D and z of the previous row (root → tip).
+        let (mut d_above, mut inverse_above, mut z_above) = (zero, zero, zero);
+        for r in 0..count {
+            let [p0, p1] = self.projected[r];
+            let diagonal = w[r + 1] * p0.dot(p0) + w[r + 2] * p1.dot(p1);
+            let mut z = self.rhs[r];
+            let mut d = diagonal;
+            if r > 0 {
+                let below = w[r + 1] * p0.dot(self.projected[r - 1][1]);
+                lower[r] = below * inverse_above;
+                d -= lower[r] * lower[r] * d_above;
+                z -= lower[r] * z_above;
+            }
+            // A pivot not clearly positive is dropped (`banded::factor`); NaN is not kept.
+            let kept: [bool; W] = core::array::from_fn(|l| {
+                let (diagonal, d) = (diagonal.0[l], d.0[l]);
+                diagonal > 0.0 && d > PIVOT_RATIO * diagonal && d.is_finite()
+            });
+            for (dropped, &kept) in dropped.iter_mut().zip(&kept) {
+                *dropped += u32::from(!kept);
+            }
+            d = Wide(core::array::from_fn(|l| if kept[l] { d.0[l] } else { 0.0 }));
+            // `banded::reciprocal`: 1/d for a kept pivot, 0 for a dropped one.
+            let inverse = Wide(core::array::from_fn(|l| {
+                let d = d.0[l];
+                if d > 0.0 {
+                    1.0 / d
+                } else {
+                    0.0
+                }
+            }));
+            fresh[r] = z * inverse;
+            (d_above, inverse_above, z_above) = (d, inverse, z);
+        }
+        // Backward: Lᵀ y = u.
+        for r in (1..count).rev() {
+            let y = fresh[r];
+            fresh[r - 1] -= lower[r] * y;
+        }
+        for (old, &new) in self.multipliers.iter_mut().zip(&fresh).take(count) {
+            *old = Wide(core::array::from_fn(|l| {
+                if solving.0[l] {
+                    new.0[l]
+                } else {
+                    old.0[l]
+                }
+            }));
+        }
+        dropped
+    }
+}
+
+/// `Σ_s ∇_{x_i}C_s δλ_s` over the segments through node `i` in lane `lane`, with the
+/// gradients before the elimination (`super::segment_pull_on_node` of that strand).
+fn segment_pull<const N: usize, const W: usize>(
+    gradient: &[V3<Wide<W>>; N],
+    multipliers: &[Wide<W>; N],
+    n: usize,
+    i: usize,
+    lane: usize,
+) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+        if !(1..n.saturating_sub(1)).contains(&segment) {
+            continue;
+        }
+        let r = segment - 1;
+        let g = gradient[r].lane(lane);
+        let g = if block == 0 { -g } else { g };
+        sum += g * multipliers[r].0[lane];
+    }
+    sum
+}
