@@ -22,7 +22,7 @@ use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
 use super::banded::{eliminate_at_node, eliminate_from_segment, PIVOT_RATIO};
-use super::constraints::{evaluate_contacts, ContactMemory, Layout, Nodes, Rows};
+use super::constraints::{evaluate_contacts, resolution_floor, ContactMemory, Layout, Nodes, Rows};
 use super::{
     conclude, free_nodes, layout_of, prune_tentative, push_on_colliders, trust_radius, trust_scale,
     usable_colliders, Findings, NearColliders, Outcome,
@@ -244,6 +244,10 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             evaluate_contacts::<M, N>((at, rest_length), nodes, near, layout, tolerance, found);
         }
         let two = Wide([2.0; W]);
+        let mut met = Met {
+            residual: core::array::from_fn(|l| self.lanes[l].rows.residual),
+            converged: core::array::from_fn(|l| self.lanes[l].rows.converged),
+        };
         for j in 1..self.nodes.saturating_sub(1) {
             let (a, b) = (self.position[j], self.position[j + 1]);
             let e = b - a;
@@ -257,11 +261,12 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 self.gradient[r] = gradient;
                 self.projected[r] = [-gradient, gradient];
             }
-            for (l, book) in self.lanes.iter_mut().enumerate() {
-                if book.running {
-                    let (a, b) = (a.lane(l), b.lane(l));
-                    book.rows.meet(value.0[l], rest2.0[l], tolerance, a, b);
-                }
+            met.meet(value, rest2, tolerance, (a, b));
+        }
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            if book.running {
+                book.rows.residual = met.residual[l];
+                book.rows.converged = met.converged[l];
             }
         }
     }
@@ -464,7 +469,8 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         let count = self.nodes.saturating_sub(2);
         let zero = Wide([0.0; W]);
         let w = &self.inverse_mass;
-        let mut dropped = [0; W];
+        // Counted in the lanes (exact below 2^24 rows).
+        let mut dropped_rows = zero;
         let mut lower = [zero; N];
         let mut fresh = [zero; N];
         // D, 1/D and z of the previous row (root → tip).
@@ -481,19 +487,18 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 z -= lower[r] * z_above;
             }
             // A pivot not clearly positive is dropped (`banded::factor`); NaN is not kept.
+            // Written without branches, `&` not `&&`, so that the lanes stay in registers.
             let kept: [bool; W] = core::array::from_fn(|l| {
                 let (diagonal, d) = (diagonal.0[l], d.0[l]);
-                diagonal > 0.0 && d > PIVOT_RATIO * diagonal && d.is_finite()
+                (diagonal > 0.0) & (d > PIVOT_RATIO * diagonal) & d.is_finite()
             });
-            for (dropped, &kept) in dropped.iter_mut().zip(&kept) {
-                *dropped += u32::from(!kept);
-            }
+            dropped_rows += Wide(kept.map(|k| if k { 0.0 } else { 1.0 }));
             d = Wide(core::array::from_fn(|l| if kept[l] { d.0[l] } else { 0.0 }));
             // `banded::reciprocal`: 1/d for a kept pivot, 0 for a dropped one.
             let inverse = Wide(core::array::from_fn(|l| {
-                let d = d.0[l];
+                let (d, reciprocal) = (d.0[l], 1.0 / d.0[l]);
                 if d > 0.0 {
-                    1.0 / d
+                    reciprocal
                 } else {
                     0.0
                 }
@@ -515,9 +520,47 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 }
             }));
         }
-        dropped
+        dropped_rows.0.map(|d| d as u32)
     }
 }
+
+/// Each lane's residual and convergence so far in an evaluation.
+struct Met<const W: usize> {
+    residual: [Real; W],
+    converged: [bool; W],
+}
+
+impl<const W: usize> Met<W> {
+    /// `Rows::meet` in every lane for the segment from `a` to `b` (`C = value`, `ê·ê =
+    /// rest2`), the same operations without branches but for the resolution floor (only while
+    /// a lane is converged and a row exceeds the tolerance, once an evaluation at most).
+    #[inline(always)]
+    fn meet(&mut self, value: Wide<W>, rest2: Wide<W>, tolerance: Real, (a, b): Ends<W>) {
+        let mut floor_wanted = false;
+        for l in 0..W {
+            let (magnitude, rest2) = (value.0[l].abs(), rest2.0[l]);
+            let residual = self.residual[l];
+            let relative = magnitude / rest2;
+            let larger = (magnitude > residual * rest2) | magnitude.is_nan();
+            let take = larger & (relative.is_nan() | (relative > residual));
+            self.residual[l] = if take { relative } else { residual };
+            floor_wanted |= self.converged[l] & (magnitude > tolerance * rest2);
+        }
+        if !floor_wanted {
+            return;
+        }
+        for l in 0..W {
+            let (magnitude, rest2) = (value.0[l].abs(), rest2.0[l]);
+            if self.converged[l] && magnitude > tolerance * rest2 {
+                let floor = resolution_floor(false, a.lane(l), b.lane(l), 0.0).min(0.01 * rest2);
+                self.converged[l] = magnitude <= floor;
+            }
+        }
+    }
+}
+
+/// A segment's two nodes in lanes.
+type Ends<const W: usize> = (V3<Wide<W>>, V3<Wide<W>>);
 
 /// `Σ_s ∇_{x_i}C_s δλ_s` over the segments through node `i` in lane `lane`, with the
 /// gradients before the elimination (`super::segment_pull_on_node` of that strand).
