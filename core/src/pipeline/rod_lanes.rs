@@ -1,14 +1,15 @@
 //! The rod's pipeline on a block of `W` strands (Kmoch 2009 Algorithm 1, as
-//! [`super::rod::step_strand`] on each). The explicit substeps of lines 3–4, the frame passes
-//! and the hair-optimised twist (lines 9–10) run for the block's strands at once, one per lane
-//! (`lane::Lanes`), through the very kernels a strand runs alone, so every strand gets the
-//! bits it gets alone. The other stages run strand by strand: the snapshot and plan, root
-//! coupling, the projection, the guard.
+//! [`super::rod::step_strand`] on each). The explicit substeps of lines 3–4, the frame passes,
+//! the fast manifold projection (line 9, `projection::lanes`) and the hair-optimised twist
+//! (lines 9–10) run for the block's strands at once, one per lane (`lane::Lanes`), through the
+//! very operations a strand runs alone, so every strand gets the bits it gets alone. The other
+//! stages run strand by strand: the snapshot and plan, root coupling, the guard.
 //!
-//! Strands that differ in their substep count are masked once they have taken theirs. A
-//! strand that takes the implicit step, projects between substeps, or has another node count
-//! than the block's steps alone; so does the twist of a strand holding a grabbed segment, and
-//! the Newton twist.
+//! Strands that differ in their substep count are masked once they have taken theirs, and
+//! strands that differ in their projection iterations once they have converged. A strand that
+//! takes the implicit step, projects between substeps, or has another node count than the
+//! block's steps alone; so does the twist and the projection of a strand holding a grabbed
+//! node, and the Newton twist.
 
 use crate::context::StepContext;
 use crate::forces::{drag, External};
