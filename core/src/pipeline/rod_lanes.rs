@@ -266,14 +266,11 @@ fn project<M: Math, const N: usize, const W: usize>(
         if begun[lane].is_none() {
             continue;
         }
-        match in_lanes && taken[lane] {
-            true => {
-                lanes.finish::<M>(lane, strand, ctx, report);
-            }
-            false => {
-                let index = first_strand + lane as u32;
-                project_constraints::<M, N>(strand, ctx, grabs, index, report);
-            }
+        if in_lanes && taken[lane] {
+            lanes.finish::<M>(lane, strand, ctx, report);
+        } else {
+            let index = first_strand + lane as u32;
+            project_constraints::<M, N>(strand, ctx, grabs, index, report);
         }
     }
 }

@@ -276,15 +276,13 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     /// not finite stops where it is.
     fn solve_and_move<M: Math>(&mut self) {
         let n = self.nodes;
-        let count = n.saturating_sub(2);
-        let dropped = self.solve();
+        let (dropped, finite) = self.solve();
         let mut moving = WideMask([false; W]);
         for (l, book) in self.lanes.iter_mut().enumerate() {
             if !book.running {
                 continue;
             }
-            let finite = self.multipliers[..count].iter().all(|m| m.0[l].is_finite());
-            if finite {
+            if finite[l] {
                 moving.0[l] = true;
             } else {
                 book.outcome.dropped_rows += 1;
@@ -378,11 +376,13 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
 
     /// `super::solve` in lanes: each running lane's contacts eliminated at their nodes, the
     /// chain solved in lanes, tentative rows that pull removed and the lane solved again.
-    /// Returns each lane's rows dropped at a singular pivot in its last solve.
-    fn solve(&mut self) -> [u32; W] {
+    /// Returns each lane's rows dropped at a singular pivot in its last solve, and whether
+    /// its multipliers are finite.
+    fn solve(&mut self) -> ([u32; W], [bool; W]) {
         let n = self.nodes;
         let mut solving = WideMask(core::array::from_fn(|l| self.lanes[l].running));
         let mut dropped = [0; W];
+        let mut finite = [false; W];
         for pass in 0..4 {
             for (l, dropped) in dropped.iter_mut().enumerate() {
                 if solving.0[l] {
@@ -397,9 +397,9 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 }
                 *dropped += chain[l];
                 let count = n.saturating_sub(2);
-                let finite = self.multipliers[..count].iter().all(|m| m.0[l].is_finite());
+                finite[l] = self.multipliers[..count].iter().all(|m| m.0[l].is_finite());
                 let book = &mut self.lanes[l];
-                if !book.rows.tentative || !finite {
+                if !book.rows.tentative || !finite[l] {
                     solving.0[l] = false;
                     continue;
                 }
@@ -417,7 +417,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 break;
             }
         }
-        dropped
+        (dropped, finite)
     }
 
     /// `banded::eliminate_contacts` on lane `lane`: its contact nodes' collision rows
