@@ -4,9 +4,10 @@
 
 use hairsim_core::collide::{Collider, Shape};
 use hairsim_core::context::StepContext;
+use hairsim_core::projection::lanes::project_strand;
 use hairsim_core::{
-    project_constraints, step_strands, Effect, Effects, Libm, Material, Mode, Params, Real, Shake,
-    StepReport, Strand, Vec3,
+    step_strands, Effect, Effects, Libm, Material, Mode, Params, Real, Shake, StepReport, Strand,
+    Vec3,
 };
 
 pub const NODES: usize = 32;
@@ -93,11 +94,11 @@ pub fn predicted_states(count: usize) -> Vec<(u32, Vec<Strand<NODES>>)> {
     captured
 }
 
-/// Projects every strand once; the summed report.
+/// Projects every strand once, as the step does (`project_strand`); the summed report.
 pub fn project_all(strands: &mut [Strand<NODES>], ctx: &StepContext) -> StepReport {
     let mut report = StepReport::default();
     for (s, strand) in strands.iter_mut().enumerate() {
-        project_constraints::<Libm, NODES>(strand, ctx, &[], s as u32, &mut report);
+        project_strand::<Libm, NODES>(strand, ctx, &[], s as u32, &mut report);
     }
     report
 }

@@ -9,7 +9,7 @@
 
 use arbitrary::Arbitrary;
 use hairsim_core::context::StepContext;
-use hairsim_core::projection::project_constraints;
+use hairsim_core::projection::lanes::project_strand;
 use hairsim_core::{
     Collider, Effect, Effects, Grab, Libm, Material, Mode, Params, Pose, Shape, StepReport, Strand,
     Vec3,
@@ -138,7 +138,7 @@ fuzz_target!(|input: Input| {
         .collect();
     let ctx = StepContext::new(&params, Pose::IDENTITY, Pose::IDENTITY, &colliders);
     let mut report = StepReport::default();
-    let outcome = project_constraints::<Libm, N>(&mut strand, &ctx, &grabs, 0, &mut report);
+    let outcome = project_strand::<Libm, N>(&mut strand, &ctx, &grabs, 0, &mut report);
     assert!(strand.is_finite(), "finite in, non-finite out");
     assert!(outcome.iterations <= u32::from(params.rod.projection_iterations));
     // Fixed-cost mode may stop early on a singular solve (degenerate colliders): its cost is

@@ -22,6 +22,7 @@ use crate::forces::External;
 use crate::grab::Grab;
 use crate::guard::{guard, sound};
 use crate::math::{unit, Math, Real, Vec3};
+use crate::projection::lanes::project_strand;
 use crate::projection::project_constraints;
 use crate::report::{Stage, StepReport};
 use crate::rod::energy::elastic_forces_with_angles;
@@ -209,7 +210,7 @@ pub(super) fn constrain<M: Math, const N: usize>(
 ) {
     couple_root(strand, ctx, begun, report);
     if ctx.gates.projection {
-        project_constraints::<M, N>(strand, ctx, grabs, index, report);
+        project_strand::<M, N>(strand, ctx, grabs, index, report);
     }
 }
 

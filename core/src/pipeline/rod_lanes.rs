@@ -16,8 +16,7 @@ use crate::forces::{drag, External};
 use crate::grab::Grab;
 use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
-use crate::projection::lanes::{fits_lanes, BlockProjection};
-use crate::projection::project_constraints;
+use crate::projection::lanes::{fits_lanes, project_strand, BlockProjection};
 use crate::report::{Stage, StepReport};
 use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
@@ -270,7 +269,7 @@ fn project<M: Math, const N: usize, const W: usize>(
             lanes.finish::<M>(lane, strand, ctx, report);
         } else {
             let index = first_strand + lane as u32;
-            project_constraints::<M, N>(strand, ctx, grabs, index, report);
+            project_strand::<M, N>(strand, ctx, grabs, index, report);
         }
     }
 }

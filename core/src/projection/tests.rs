@@ -8,6 +8,7 @@ use crate::head::Pose;
 use crate::math::Libm;
 use crate::params::Params;
 use crate::strand::Material;
+use std::vec::Vec;
 
 const N: usize = 32;
 
@@ -595,4 +596,79 @@ fn a_node_just_outside_that_the_segments_pull_in_is_held_in_the_same_iteration()
         }
     }
     assert_eq!(iterations[0], iterations[1], "{iterations:?}");
+}
+
+/// The bits of what a projection leaves: positions, velocities, outcome and report (but its
+/// flags).
+fn projected_bits(strand: &Strand<N>, outcome: &Outcome, report: &StepReport) -> Vec<u32> {
+    let state = strand.state.position.iter().chain(&strand.state.velocity);
+    let mut bits: Vec<u32> = state.flat_map(|v| v.to_array().map(f32::to_bits)).collect();
+    bits.extend([outcome.iterations, outcome.residual.to_bits()]);
+    bits.extend([u32::from(outcome.converged), outcome.dropped_rows]);
+    let measures = [
+        report.residual,
+        report.max_stretch,
+        report.max_contact_stretch,
+    ];
+    bits.extend(measures.map(f32::to_bits));
+    bits.extend([
+        report.max_penetration.to_bits(),
+        report.contacts,
+        report.cap_hits,
+    ]);
+    bits.extend([report.iterations_total, report.dropped_rows]);
+    bits.extend(report.stage_runs);
+    let pushed = report.collider_forces.iter().flat_map(|f| f.to_array());
+    bits.extend(pushed.map(f32::to_bits));
+    bits
+}
+
+/// `lanes::project_strand` takes a strand that `lanes::fits_lanes` through the lanes' kernel
+/// at one lane; the general kernel, `project_constraints`, must give that strand the same
+/// bits: shaken strands, in both modes, with and without a sphere they fall
+/// into, converging or stopped at a low cap.
+#[test]
+fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
+    let sphere = Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::new(0.1, -0.045, 0.0),
+            radius: 0.05,
+        },
+        attached_to_head: false,
+    };
+    let mut contacts = 0;
+    for mode in [Mode::FixedCost, Mode::Converge] {
+        for (effects, colliders) in [
+            (&[Effect::Inextensibility][..], &[][..]),
+            (
+                &[Effect::Inextensibility, Effect::Collisions][..],
+                &[sphere][..],
+            ),
+        ] {
+            for (cap, tolerance) in [(8, 1.0e-6), (2, 1.0e-6), (20, 1.0e-3)] {
+                let p = params(effects, mode, cap, tolerance);
+                let ctx = context(&p, colliders);
+                for k in 0..6 {
+                    let direction = Vec3::new(1.0, -0.1 * k as Real, 0.05).normalize();
+                    let mut strand = line(20, Vec3::ZERO, direction);
+                    shake_nodes(&mut strand, 0.001 * (k + 1) as Real);
+                    assert!(lanes::fits_lanes(&strand, &ctx, &[], 0, 20));
+                    let mut general = strand.clone();
+                    let (mut a, mut b) = (StepReport::default(), StepReport::default());
+                    let outcome =
+                        lanes::project_strand::<Libm, N>(&mut strand, &ctx, &[], 0, &mut a);
+                    let other = project_constraints::<Libm, N>(&mut general, &ctx, &[], 0, &mut b);
+                    let case = std::format!("{mode:?} {effects:?} cap {cap} k {k}");
+                    assert_eq!(
+                        projected_bits(&strand, &outcome, &a),
+                        projected_bits(&general, &other, &b),
+                        "{case}"
+                    );
+                    assert_eq!(a.flags, b.flags, "{case}");
+                    contacts += a.contacts;
+                }
+            }
+        }
+    }
+    assert!(contacts > 100, "the sphere was touched {contacts} times");
 }
