@@ -6,7 +6,8 @@ function of the core (the innermost one, inlined or not) and per source line, an
 dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or chained (against the
 static share `latency.py` assumes), and the executed mix by kind of instruction: floating-point
 arithmetic (flops, counting a multiply-accumulate as two), loads and stores, moves, integer work
-and branches (`docs/study/floors.md` sets the floating-point part against the models' floors).
+and branches (`docs/study/floors.md` sets the floating-point part against the models' floors),
+and the instructions per stage of the step.
 
     cd firmware && HAIRSIM_PROFILE=dftl_noshape cargo build --release
     qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic -icount shift=0 \\
@@ -85,6 +86,47 @@ def read_trace(path, marks):
     return blocks, runs
 
 
+# The stage an instruction belongs to: the module of the outermost frame of the core's inline
+# chain that lies outside the pipeline's own files (which only sequence the stages). Functions
+# that are not inlined start a chain of their own, so a helper called from several stages
+# (libm, the compiler's memset and memcpy) counts under its own name.
+STAGES = (
+    ("rod/frames.rs", "frame passes"),
+    ("src/frames.rs", "frame passes"),
+    ("rod/energy.rs", "elastic forces"),
+    ("rod/integrate.rs", "symplectic Euler"),
+    ("rod/substeps.rs", "substep plan"),
+    ("rod/twist.rs", "twist"),
+    ("projection/", "projection and velocities"),
+    ("root_coupling.rs", "root coupling"),
+    ("guard.rs", "guard and snapshot"),
+    ("snapshot.rs", "guard and snapshot"),
+    ("forces.rs", "external forces"),
+    ("collide.rs", "projection and velocities"),
+)
+
+
+def stage(core, pairs):
+    """The stage of an instruction whose inline chain (innermost first) is `pairs`, of which
+    `core` are the frames in the core's source."""
+    for _, where in reversed(core):
+        if "/pipeline/" in where:
+            continue
+        for part, name in STAGES:
+            if part in where:
+                return name
+        return "other core: " + where.split("/core/src/")[-1].split(":")[0]
+    if core:
+        return "pipeline (sequencing, gathering, bookkeeping)"
+    # No line of the core's source: name the chain by its outermost function.
+    outermost = re.sub(r"<.*", "", pairs[-1][0])
+    if outermost.startswith(("sincos", "fmax", "fmin", "atan", "floor")):
+        return "libm (sincosf, fmaxf, fminf)"
+    if outermost.startswith("elastic_forces"):
+        return "elastic forces"
+    return "memory fills and copies (compiler-builtins)"
+
+
 def main():
     trace, elf = sys.argv[1], sys.argv[2]
     rows = int(sys.argv[3]) if len(sys.argv) > 3 else 30
@@ -103,7 +145,7 @@ def main():
     out = subprocess.run(["llvm-symbolizer", "--obj=" + elf, "--inlining", "--functions=short"],
                          input="\n".join(hex(a) for a in addresses), check=True,
                          capture_output=True, text=True).stdout
-    by_function, by_line = collections.Counter(), collections.Counter()
+    by_function, by_line, by_stage = (collections.Counter() for _ in range(3))
     for address, frames in zip(addresses, out.strip("\n").split("\n\n")):
         lines = frames.split("\n")
         pairs = [(lines[i], lines[i + 1]) for i in range(0, len(lines) - 1, 2)]
@@ -112,6 +154,7 @@ def main():
         function, where = core[0] if core else pairs[0]
         by_function[function] += per_address[address]
         by_line["/".join(where.split("/")[-2:])] += per_address[address]
+        by_stage[stage(core, pairs)] += per_address[address]
     slow, mac = kinds["VDIV/VSQRT"], kinds["multiply-accumulate"]
     print(f"{steps} steps, {total / steps:.0f} instructions per step; executed VDIV/VSQRT "
           f"{100 * slow / total:.2f} %, multiply-accumulate {100 * mac / total:.2f} % -> "
@@ -123,7 +166,8 @@ def main():
     print("\n| kind | instructions per step | share |\n|---|---:|---:|")
     for name, n in kinds.most_common():
         print(f"| {name} | {n / steps:.0f} | {100 * n / total:.1f} % |")
-    for title, counter in (("function", by_function), ("source line", by_line)):
+    for title, counter in (("stage", by_stage), ("function", by_function),
+                           ("source line", by_line)):
         print(f"\n| {title} | instructions per step | share |\n|---|---:|---:|")
         for name, n in counter.most_common(rows):
             print(f"| {name} | {n / steps:.0f} | {100 * n / total:.1f} % |")

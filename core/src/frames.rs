@@ -28,10 +28,18 @@ pub fn curvature_binormal<P: Kernel>(
     let d = rest_length_prev * rest_length_next + e_prev.dot(e_next);
     let inverse_d = P::R::ONE / d;
     (
-        e_prev.cross(e_next) * (P::R::of(2.0) * inverse_d),
+        curvature_binormal_over::<P>(e_prev, e_next, inverse_d),
         d,
         inverse_d,
     )
+}
+
+/// [`curvature_binormal`] given the reciprocal of its denominator, `1/d`: the rod's frame pass
+/// takes `1/d` from a division it shares with two other reciprocals.
+#[inline(always)]
+#[must_use]
+pub fn curvature_binormal_over<P: Kernel>(e_prev: P::V, e_next: P::V, inverse_d: P::R) -> P::V {
+    e_prev.cross(e_next) * (P::R::of(2.0) * inverse_d)
 }
 
 /// The parallel transport of `v` along the rotation about `t_from × t_to` that takes the unit

@@ -230,6 +230,39 @@ pub struct Layout {
     pub residual_only: bool,
 }
 
+impl Layout {
+    /// Whether an evaluation measures the segments' share of the residual and the
+    /// convergence test. Fixed cost runs every iteration whatever they say, so it measures
+    /// them once, at its last evaluation (and where a projection stops early,
+    /// [`measure_segments`]); converge mode measures them at every evaluation.
+    #[inline(always)]
+    #[must_use]
+    pub fn measures_segments(self) -> bool {
+        self.residual_only || !self.fixed_cost
+    }
+}
+
+/// The segments' share of the residual and the convergence test at the positions `at(i)`
+/// (segments with a free node, rest lengths `rest_length`), into `rows`: what the evaluation a
+/// fixed-cost projection stopped after did not measure ([`Layout::measures_segments`]).
+pub(crate) fn measure_segments<const N: usize>(
+    at: impl Fn(usize) -> Vec3,
+    rest_length: &[Real; N],
+    nodes: &Nodes<N>,
+    tolerance: Real,
+    rows: &mut Rows<N>,
+) {
+    let count = nodes.count.min(N);
+    for (i, &rest) in rest_length.iter().enumerate().take(count.saturating_sub(1)) {
+        if nodes.is_free(i) || nodes.is_free(i + 1) {
+            let (a, b) = (at(i), at(i + 1));
+            let rest2 = rest * rest;
+            let e = b - a;
+            rows.meet(e.dot(e) - rest2, rest2, tolerance, a, b);
+        }
+    }
+}
+
 /// The constraints at one iterate: segment rows in band order, collision rows by node.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rows<const N: usize> {
@@ -743,7 +776,9 @@ fn lay_out_segments<const N: usize>(
                 rows.meet(value, rest2, tolerance, a, b);
             } else {
                 let row = Row::segment(i, a, b, rest_length[i]);
-                rows.meet(row.value, rest2, tolerance, a, b);
+                if layout.measures_segments() {
+                    rows.meet(row.value, rest2, tolerance, a, b);
+                }
                 let first = previous_segment.unwrap_or(rows.count);
                 previous_segment = rows.push(row, first);
                 if let Some(r) = previous_segment {

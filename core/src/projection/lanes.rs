@@ -27,7 +27,9 @@ use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
 use super::banded::{eliminate_at_node, eliminate_from_segment, PIVOT_RATIO};
-use super::constraints::{evaluate_contacts, resolution_floor, ContactMemory, Layout, Nodes, Rows};
+use super::constraints::{
+    evaluate_contacts, measure_segments, resolution_floor, ContactMemory, Layout, Nodes, Rows,
+};
 use super::{
     conclude, free_nodes, layout_of, project_constraints, prune_tentative, push_on_colliders,
     trust_radius, trust_scale, usable_colliders, Findings, NearColliders, Outcome,
@@ -119,6 +121,10 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     gradient: [V3<Wide<W>>; N],
     projected: [[V3<Wide<W>>; 2]; N],
     multipliers: [Wide<W>; N],
+    /// The chain's factor `L` below the diagonal and its solution in the making
+    /// (`solve_chain`): written before they are read, kept here so that no solve zeroes them.
+    lower: [Wide<W>; N],
+    fresh: [Wide<W>; N],
     step: [V3<Wide<W>>; N],
     lanes: [Lane<N>; W],
 }
@@ -137,6 +143,8 @@ impl<const N: usize, const W: usize> Default for BlockProjection<N, W> {
             gradient: [V3::zero(); N],
             projected: [[V3::zero(); 2]; N],
             multipliers: [zero; N],
+            lower: [zero; N],
+            fresh: [zero; N],
             step: [V3::zero(); N],
             lanes: core::array::from_fn(|_| Lane {
                 nodes: Nodes {
@@ -259,6 +267,29 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 break;
             }
             self.solve_and_move::<M>();
+            if fixed_cost {
+                self.measure_stopped(strands, k, tolerance);
+            }
+        }
+    }
+
+    /// In fixed cost, the segments' share of the residual of each lane that stopped in
+    /// iteration `k` before its last (its multipliers or moves not finite), at the positions
+    /// it keeps: its evaluation skipped it (`Layout::measures_segments`).
+    fn measure_stopped(&mut self, strands: &[Strand<N>], k: u32, tolerance: Real) {
+        let position = &self.position;
+        for (l, book) in self.lanes.iter_mut().enumerate() {
+            if book.running || book.outcome.iterations != k || !self.taken[l] {
+                continue;
+            }
+            let Some(strand) = strands.get(l) else {
+                continue;
+            };
+            let at = |i: usize| position[i].lane(l);
+            let rest_length = &strand.rest.segment_length;
+            measure_segments(at, rest_length, &book.nodes, tolerance, &mut book.rows);
+            book.outcome.residual = book.rows.residual;
+            book.outcome.converged = book.rows.converged;
         }
     }
 
@@ -301,7 +332,9 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 self.gradient[r] = gradient;
                 self.projected[r] = [-gradient, gradient];
             }
-            met.meet(value, rest2, tolerance, (a, b));
+            if layout.measures_segments() {
+                met.meet(value, rest2, tolerance, (a, b));
+            }
         }
         for (l, book) in self.lanes.iter_mut().enumerate() {
             if book.running {
@@ -511,8 +544,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         let w = &self.inverse_mass;
         // Counted in the lanes (exact below 2^24 rows).
         let mut dropped_rows = zero;
-        let mut lower = [zero; N];
-        let mut fresh = [zero; N];
+        let (lower, fresh) = (&mut self.lower, &mut self.fresh);
         // D, 1/D and z of the previous row (root → tip).
         let (mut d_above, mut inverse_above, mut z_above) = (zero, zero, zero);
         for r in 0..count {
@@ -551,7 +583,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             let y = fresh[r];
             fresh[r - 1] -= lower[r] * y;
         }
-        for (old, &new) in self.multipliers.iter_mut().zip(&fresh).take(count) {
+        for (old, &new) in self.multipliers.iter_mut().zip(fresh.iter()).take(count) {
             *old = Wide(core::array::from_fn(|l| {
                 if solving.0[l] {
                     new.0[l]

@@ -353,6 +353,13 @@ fn iterate<M: Math, const N: usize>(
             // A non-finite multiplier (overflow on absurd input): keep x_k, stop, report.
             None => {
                 outcome.dropped_rows += 1;
+                if !layout.measures_segments() && layout.inextensibility {
+                    let (x, rest_length) = (&strand.state.position, &strand.rest.segment_length);
+                    let (nodes, rows) = (&work.nodes, &mut work.rows);
+                    constraints::measure_segments(|i| x[i], rest_length, nodes, tolerance, rows);
+                    outcome.residual = work.rows.residual;
+                    outcome.converged = work.rows.converged;
+                }
                 break;
             }
         }

@@ -625,8 +625,8 @@ fn projected_bits(strand: &Strand<N>, outcome: &Outcome, report: &StepReport) ->
 
 /// `lanes::project_strand` takes a strand that `lanes::fits_lanes` through the lanes' kernel
 /// at one lane; the general kernel, `project_constraints`, must give that strand the same
-/// bits: shaken strands, in both modes, with and without a sphere they fall
-/// into, converging or stopped at a low cap.
+/// bits: shaken strands, in both modes, with and without a sphere they fall into, converging,
+/// stopped at a low cap, or stopped early by garbage.
 #[test]
 fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
     let sphere = Collider {
@@ -636,7 +636,7 @@ fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
         },
         attached_to_head: false,
     };
-    let mut contacts = 0;
+    let (mut contacts, mut stopped) = (0, 0);
     for mode in [Mode::FixedCost, Mode::Converge] {
         for (effects, colliders) in [
             (&[Effect::Inextensibility][..], &[][..]),
@@ -652,6 +652,11 @@ fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
                     let direction = Vec3::new(1.0, -0.1 * k as Real, 0.05).normalize();
                     let mut strand = line(20, Vec3::ZERO, direction);
                     shake_nodes(&mut strand, 0.001 * (k + 1) as Real);
+                    if k == 5 {
+                        // Garbage: `e·e` overflows, the multipliers are not finite, the
+                        // projection stops before its cap.
+                        strand.state.position[7] = Vec3::splat(3.0e19);
+                    }
                     assert!(lanes::fits_lanes(&strand, &ctx, &[], 0, 20));
                     let mut general = strand.clone();
                     let (mut a, mut b) = (StepReport::default(), StepReport::default());
@@ -666,9 +671,14 @@ fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
                     );
                     assert_eq!(a.flags, b.flags, "{case}");
                     contacts += a.contacts;
+                    stopped += u32::from(k == 5 && outcome.iterations < u32::from(cap));
                 }
             }
         }
     }
     assert!(contacts > 100, "the sphere was touched {contacts} times");
+    assert_eq!(
+        stopped, 12,
+        "garbage stopped the projection early in {stopped} cases of 12"
+    );
 }
