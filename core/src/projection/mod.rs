@@ -900,6 +900,11 @@ fn record_grabs<M: Math, const N: usize>(
         // −Σ ∇_{x_g}C_jᵀΛ_j/h² − m_g(a_g − g), with m_g(a_g − g) = m_g Δx_g/h².
         let delta_x = x - x_pred;
         let felt = (pull - delta_x * mass) * inv_h2;
+        // A strand that blew up before or in its projection (the guard rolls it back) has no
+        // force to report: no NaN leaves the step through the grab's force.
+        if !crate::math::is_finite(felt) {
+            continue;
+        }
         if let Some(force) = report.grab_forces.get_mut(g) {
             *force += felt;
         }

@@ -682,3 +682,27 @@ fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
         "garbage stopped the projection early in {stopped} cases of 12"
     );
 }
+
+/// A strand that blew up before its projection (a grabbed node's predicted position is NaN;
+/// the guard rolls the strand back after it) has no force to report on its grab: no NaN
+/// leaves the step through `grab_forces`.
+#[test]
+fn a_grabbed_strand_that_blew_up_reports_no_nan_force() {
+    let p = params(
+        &[Effect::Inextensibility, Effect::Grabs],
+        Mode::FixedCost,
+        4,
+        1.0e-6,
+    );
+    let ctx = context(&p, &[]);
+    let mut strand = line(12, Vec3::ZERO, Vec3::X);
+    strand.state.position[9] = Vec3::NAN;
+    let grabs = [Grab::new(0, 9, Vec3::new(0.09, 0.0, 0.0), 1.0)];
+    let mut report = StepReport::default();
+    project_constraints::<Libm, N>(&mut strand, &ctx, &grabs, 0, &mut report);
+    assert!(
+        report.grab_forces.iter().all(|f| f.is_finite()),
+        "{:?}",
+        report.grab_forces
+    );
+}
