@@ -252,9 +252,9 @@ pub const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
 /// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
 /// doubled angle is a complex square, the half angle a square root.
 ///
-/// One division: the weights `1/r_k` are kept as a fraction `Σ z_k/r_k = sum / scale`, whose
-/// direction is that of `sum`; the half angle of `z = X + iY` is `(|z| + X, Y)` (or
-/// `(Y, |z| − X)`, the same line, when `X < 0`), normalised once.
+/// Two divisions: the weights `1/r_k` share one (`Σ z_k/r_k` is kept as a fraction), and the
+/// half angle of `z = X + iY` is `(|z| + X, Y)` (or `(Y, |z| − X)`, the same line, when
+/// `X < 0`), normalised once.
 #[inline(always)]
 #[must_use]
 pub fn binormal_direction<P: Precision, const N: usize>(
@@ -292,8 +292,6 @@ pub fn binormal_direction_in_lanes<P: Kernel, const N: usize>(
     if j < n {
         add(frames.bishop_curvature[j + 1][0]);
     }
-    // The direction of `sum / scale` is that of `sum` (`scale > 0`): only the weight test
-    // needs the scale, and it multiplies instead of dividing.
     let inverse_scale = P::R::ONE / scale;
     let (x, y) = (sum[0] * inverse_scale, sum[1] * inverse_scale);
     let weight2 = x * x + y * y;
