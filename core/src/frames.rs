@@ -35,7 +35,7 @@ pub fn curvature_binormal<P: Kernel>(
 }
 
 /// [`curvature_binormal`] given the reciprocal of its denominator, `1/d`: the rod's frame pass
-/// takes `1/d` from a division it shares with two other reciprocals.
+/// takes `1/d` from a division it shares with another reciprocal.
 #[inline(always)]
 #[must_use]
 pub fn curvature_binormal_over<P: Kernel>(e_prev: P::V, e_next: P::V, inverse_d: P::R) -> P::V {

@@ -16,7 +16,7 @@ use crate::forces::{drag, External};
 use crate::grab::Grab;
 use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
-use crate::projection::lanes::{fits_lanes, project_strand, BlockProjection};
+use crate::projection::lanes::{fits_lanes, project_alone, project_strand, BlockProjection};
 use crate::report::{Stage, StepReport};
 use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
@@ -265,8 +265,11 @@ fn project<M: Math, const N: usize, const W: usize>(
         if begun[lane].is_none() {
             continue;
         }
+        // A strand `taken` fits the lanes' kernel: no second `fits_lanes` for it.
         if in_lanes && taken[lane] {
             lanes.finish::<M>(lane, strand, ctx, report);
+        } else if taken[lane] {
+            project_alone::<M, N>(strand, ctx, report);
         } else {
             let index = first_strand + lane as u32;
             project_strand::<M, N>(strand, ctx, grabs, index, report);

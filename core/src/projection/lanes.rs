@@ -79,7 +79,7 @@ pub fn project_strand<M: Math, const N: usize>(
 /// one lane: no row map, no grab, no padding row. Not inlined, so that its scratch space and
 /// the general projection's are not both on the stack.
 #[inline(never)]
-fn project_alone<M: Math, const N: usize>(
+pub(crate) fn project_alone<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     report: &mut StepReport,

@@ -109,25 +109,24 @@ impl<P: Kernel, const N: usize> RodFrames<P, N> {
         for j in 0..segments {
             let e = positions[j + 1] - positions[j];
             let length = P::sqrt(e.dot(e));
+            let inverse_length = P::R::ONE / length;
+            let t = e * inverse_length;
             f.edge[j] = e;
             f.length[j] = length;
+            f.inverse_length[j] = inverse_length;
+            f.tangent[j] = t;
             if j == 0 {
-                let inverse_length = P::R::ONE / length;
-                let t = e * inverse_length;
-                f.inverse_length[0] = inverse_length;
-                f.tangent[0] = t;
                 f.bishop_u[0] = root_frame;
                 f.bishop_v[0] = t.cross(root_frame);
                 continue;
             }
             let i = j;
             let (e_prev, t_prev) = (f.edge[i - 1], f.tangent[i - 1]);
-            let mut reciprocals = Reciprocals::<P>::at_node(e_prev, e, f.length[i - 1], length);
-            let d = reciprocals.denominator(rest_length[i - 1], rest_length[i]);
-            let [inverse_length, inverse_one_plus_cos, inverse_d] = reciprocals.of(d);
-            let t = e * inverse_length;
-            f.inverse_length[j] = inverse_length;
-            f.tangent[j] = t;
+            let lengths = f.length[i - 1] * length;
+            let dot = e_prev.dot(e);
+            let d = rest_length[i - 1] * rest_length[i] + dot;
+            let (inverse_bracket, inverse_d) = shared_reciprocals(lengths + dot, d);
+            let inverse_one_plus_cos = lengths * inverse_bracket;
             let u =
                 transport_perpendicular::<P>(t_prev, t, f.bishop_u[i - 1], inverse_one_plus_cos);
             let v = t.cross(u);
@@ -138,7 +137,7 @@ impl<P: Kernel, const N: usize> RodFrames<P, N> {
             f.denominator[i] = d;
             f.inverse_denominator[i] = inverse_d;
             // `½ d / (|e^{i−1}||e^i| (1 + t^{i−1}·t^i))`, the reciprocal of the bracket.
-            f.holonomy_scale[i] = P::R::of(0.5) * d * reciprocals.inverse_bracket;
+            f.holonomy_scale[i] = P::R::of(0.5) * d * inverse_bracket;
             // The transport turns about (κb)_i, so the binormal has the same components in
             // the Bishop frames on both sides of node i: two dot products serve both.
             let p = [kb.dot(v), -kb.dot(u)];
@@ -153,56 +152,16 @@ impl<P: Kernel, const N: usize> RodFrames<P, N> {
     }
 }
 
-/// The three reciprocals the frame pass takes at interior node `i`: of the segment length
-/// `|e^i|` (the tangent), of `1 + t^{i−1}·t^i` (the transport and the holonomy) and of the
-/// curvature binormal's denominator `d_i = |ê^{i−1}||ê^i| + e^{i−1}·e^i`. The last two share
-/// one division, `1/a = b/(ab)`: two `VDIV`s (14 cycles each on the Cortex-M4F) instead of
-/// three. The cosine's bracket is `|e^{i−1}||e^i| + e^{i−1}·e^i`, from the edges, so nothing
-/// waits for the tangent. (All three from one division made the viewer's test of a dragged
-/// grab, `tests/viewer.rs`, slip at its second drag; two divisions, or three, did not.)
-struct Reciprocals<P: Kernel> {
-    length: P::R,
-    /// `|e^{i−1}||e^i|`.
-    lengths: P::R,
-    /// `e^{i−1}·e^i`.
-    dot: P::R,
-    /// `|e^{i−1}||e^i| (1 + t^{i−1}·t^i) = |e^{i−1}||e^i| + e^{i−1}·e^i`.
-    bracket: P::R,
-    /// `1 / bracket`, set by [`Self::of`].
-    inverse_bracket: P::R,
-}
-
-impl<P: Kernel> Reciprocals<P> {
-    #[inline(always)]
-    fn at_node(e_prev: P::V, e: P::V, length_prev: P::R, length: P::R) -> Self {
-        let lengths = length_prev * length;
-        let dot = e_prev.dot(e);
-        Reciprocals {
-            length,
-            lengths,
-            dot,
-            bracket: lengths + dot,
-            inverse_bracket: P::R::ZERO,
-        }
-    }
-
-    /// `d_i` with the rest lengths `rest_prev`, `rest` (`frames::curvature_binormal`'s).
-    #[inline(always)]
-    fn denominator(&self, rest_prev: P::R, rest: P::R) -> P::R {
-        rest_prev * rest + self.dot
-    }
-
-    /// `[1/|e^i|, 1/(1 + t^{i−1}·t^i), 1/d]`, keeping `1/bracket`.
-    #[inline(always)]
-    fn of(&mut self, d: P::R) -> [P::R; 3] {
-        let r = P::R::ONE / (self.bracket * d);
-        self.inverse_bracket = r * d;
-        [
-            P::R::ONE / self.length,
-            self.lengths * self.inverse_bracket,
-            r * self.bracket,
-        ]
-    }
+/// `(1/bracket, 1/d)` from one division, `1/a = b/(ab)`: the frame pass's reciprocals of the
+/// cosine's bracket `|e^{i−1}||e^i| (1 + t^{i−1}·t^i) = |e^{i−1}||e^i| + e^{i−1}·e^i` (from the
+/// edges, so nothing waits for the tangent) and of the curvature binormal's denominator `d_i`.
+/// One `VDIV` (14 cycles on the Cortex-M4F) instead of two. `1/|e^i|` keeps its own: taking
+/// all three from one division made the viewer's test of a dragged grab, `tests/viewer.rs`,
+/// slip at its second drag.
+#[inline(always)]
+fn shared_reciprocals<R: Arithmetic>(bracket: R, d: R) -> (R, R) {
+    let r = R::ONE / (bracket * d);
+    (r * d, r * bracket)
 }
 
 impl<M: Math, const N: usize> RodFrames<M, N> {
