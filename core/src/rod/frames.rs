@@ -211,9 +211,9 @@ pub const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
 /// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
 /// doubled angle is a complex square, the half angle a square root.
 ///
-/// Two divisions: the weights `1/r_k` share one (`Σ z_k/r_k` is kept as a fraction), and the
-/// half angle of `z = X + iY` is `(|z| + X, Y)` (or `(Y, |z| − X)`, the same line, when
-/// `X < 0`), normalised once.
+/// One division: the weights `1/r_k` are kept as a fraction `Σ z_k/r_k = sum / scale`, whose
+/// direction is that of `sum`, and the half angle of `z = X + iY` is `(|z| + X, Y)` (or
+/// `(Y, |z| − X)`, the same line, when `X < 0`), normalised once.
 #[inline(always)]
 #[must_use]
 pub fn binormal_direction<P: Precision, const N: usize>(
@@ -251,11 +251,15 @@ pub fn binormal_direction_in_lanes<P: Kernel, const N: usize>(
     if j < n {
         add(frames.bishop_curvature[j + 1][0]);
     }
-    let inverse_scale = P::R::ONE / scale;
-    let (x, y) = (sum[0] * inverse_scale, sum[1] * inverse_scale);
+    // The weights' fraction `sum / scale` has the direction of `sum` (`scale` > 0), so only
+    // the test of its length needs `scale`: `|sum / scale| > min` as `|sum|² > (min scale)²`,
+    // no division. `|sum|²` overflows only for curvatures past 1e4 (a fold within a few
+    // thousandths of a degree of 180°), which then reads as no direction: the sweep continues
+    // the neighbour, as for a non-finite frame.
+    let [x, y] = sum;
     let weight2 = x * x + y * y;
-    let min = P::R::of(BINORMAL_MIN_WEIGHT);
-    let some = !(weight2.le(min * min) | !weight2.finite());
+    let bound = P::R::of(BINORMAL_MIN_WEIGHT) * scale;
+    let some = !(weight2.le(bound * bound) | !weight2.finite());
     if !P::R::any(some) {
         return ([P::R::ONE, P::R::ZERO], some);
     }
