@@ -35,7 +35,7 @@ impl Math for HostMath {
     }
     #[inline(always)]
     fn sin_cos(x: Real) -> (Real, Real) {
-        libm::sincosf(x)
+        hairsim_core::math::sin_cos(x)
     }
     #[inline(always)]
     fn atan2(y: Real, x: Real) -> Real {

@@ -14,6 +14,12 @@ of libm, not the formatting, semihosting and start-up code around them (a static
 standing in for the dynamic one):
 cycles = instructions × (1 + 13·share(VDIV, VSQRT) + 2·share(multiply-accumulate)).
 
+The `collision rows` lines give what a collision row costs: the modelled cycles the head's
+sphere adds to a 32-node rod scene (its steps with the sphere less its steps without) divided
+by the collision rows its projection solved (each row counted at every iterate a solve
+followed), against 1.5x a collision row's floor of 61 cycles (docs/study/floors.md section 3).
+Two scenes: the latency table's violent one and one strand draped over the head.
+
 Usage: latency.py FIRMWARE_LOG FIRMWARE_ELF
 """
 import re
@@ -23,6 +29,9 @@ import sys
 INSTRUCTIONS_PER_TICK = 40
 CLOCK_HZ = 168e6
 BUDGET_CYCLES = 0.5e-3 * CLOCK_HZ
+# A collision row's floor, cycles, and the share of it the goal allows.
+COLLISION_ROW_FLOOR = 61
+COLLISION_ROW_GOAL = 1.5 * COLLISION_ROW_FLOOR
 # The 3-cycle multiply-accumulates of the Cortex-M4F's FPU, fused and chained.
 MULTIPLY_ACCUMULATE = ("vfma", "vfms", "vfnma", "vfnms", "vmla", "vmls", "vnmla", "vnmls")
 
@@ -77,6 +86,19 @@ def main():
         k = lambda v: "/".join(f"{x / 1000:.1f}" for x in v)
         print(f"| {solver} | {nodes} | {k(calm)} | {k(violent)} | "
               f"{violent[2] / calm[1]:.3f} | {cycles / CLOCK_HZ * 1e6:.0f} | {'yes' if fits else 'no'} |")
+    for line in open(log):
+        m = re.match(r"collision rows rod (\w+) nodes (\d+) steps (\d+) with (\d+) without (\d+) "
+                     r"rows (\d+)", line)
+        if not m:
+            continue
+        scene = m.group(1)
+        nodes, steps, with_, without, rows = (int(g) for g in m.groups()[1:])
+        added = (with_ - without) * INSTRUCTIONS_PER_TICK * factor
+        per_row = added / rows if rows else float("inf")
+        print(f"collision rows, rod {nodes} nodes {scene}, {steps} steps: {rows} rows "
+              f"({rows / steps:.1f} a step); the sphere adds {added / steps:.0f} cycles a step, "
+              f"{per_row:.0f} a row against {COLLISION_ROW_GOAL:.1f} (1.5 x {COLLISION_ROW_FLOOR}): "
+              f"{'met' if per_row <= COLLISION_ROW_GOAL else 'missed'}")
     for solver in ("rod", "dftl", "dftl_noshape"):
         print(f"largest {solver} scene within half a 1 ms tick at 168 MHz: "
               f"{best.get(solver, 0) or 'none of those measured'} nodes")

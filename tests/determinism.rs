@@ -190,6 +190,7 @@ mod rod_blocks {
                 (
                     reals.map(Real::to_bits),
                     r.contacts,
+                    r.collision_rows,
                     r.dropped_rows,
                     r.cap_hits,
                     r.flags,

@@ -21,7 +21,7 @@ impl Math for HostMath {
         x.sqrt()
     }
     fn sin_cos(x: Real) -> (Real, Real) {
-        libm::sincosf(x)
+        hairsim_core::math::sin_cos(x)
     }
     fn atan2(y: Real, x: Real) -> Real {
         hairsim_core::math::atan2(y, x)

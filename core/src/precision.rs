@@ -143,6 +143,8 @@ pub trait Scalar: Arithmetic<Mask = bool> + Default + PartialOrd {
     const PI: Self;
     /// 1/π.
     const FRAC_1_PI: Self;
+    /// The machine epsilon: the gap between 1 and the next value.
+    const EPSILON: Self;
     /// The value rounded to `f32`.
     fn to_f32(self) -> f32;
     /// `|x|`.
@@ -160,6 +162,7 @@ pub trait Scalar: Arithmetic<Mask = bool> + Default + PartialOrd {
 impl Scalar for f32 {
     const PI: Self = core::f32::consts::PI;
     const FRAC_1_PI: Self = core::f32::consts::FRAC_1_PI;
+    const EPSILON: Self = f32::EPSILON;
     #[inline(always)]
     fn to_f32(self) -> f32 {
         self
@@ -196,6 +199,7 @@ impl Scalar for f32 {
 impl Scalar for f64 {
     const PI: Self = core::f64::consts::PI;
     const FRAC_1_PI: Self = core::f64::consts::FRAC_1_PI;
+    const EPSILON: Self = f64::EPSILON;
     #[inline(always)]
     fn to_f32(self) -> f32 {
         self as f32

@@ -129,6 +129,11 @@ pub struct StepReport {
     pub max_penetration: Real,
     /// Nodes that got a collision row in this step's projection (pushed out of a collider).
     pub contacts: u32,
+    /// Collision rows the rod's projection solved, summed over its iterations and strands: a
+    /// row present at `k` iterates counts `k` times (`projection::Outcome::collision_rows`).
+    /// What a collision row costs is the step's cost with the collider less without, divided
+    /// by this (`firmware/latency.rs`).
+    pub collision_rows: u32,
     /// Strands rolled back to their last good state.
     pub rolled_back: u32,
     /// The first [`NAMED_STRANDS`] rolled-back strands, by index.
@@ -182,6 +187,7 @@ impl Default for StepReport {
             max_contact_stretch: 0.0,
             max_penetration: 0.0,
             contacts: 0,
+            collision_rows: 0,
             rolled_back: 0,
             rolled_back_strands: heapless::Vec::new(),
             grab_forces: [Vec3::ZERO; MAX_GRABS],
@@ -259,6 +265,7 @@ impl StepReport {
         self.max_contact_stretch = self.max_contact_stretch.max(other.max_contact_stretch);
         self.max_penetration = self.max_penetration.max(other.max_penetration);
         self.contacts += other.contacts;
+        self.collision_rows += other.collision_rows;
         self.rolled_back += other.rolled_back;
         for &s in &other.rolled_back_strands {
             let _ = self.rolled_back_strands.push(s);

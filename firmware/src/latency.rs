@@ -19,9 +19,10 @@ const STEPS: usize = 200;
 /// Steps per run when profiling one scene (a QEMU execution trace grows by ~7 MB per step).
 const PROFILE_STEPS: usize = 6;
 
-/// Set at build time (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape cargo build --release`): run only
-/// that scene, the 128-node rod or the 512-vertex DFTL one, for [`PROFILE_STEPS`] steps calm
-/// and violent, with [`step_begins`] and [`step_ends`] around each step, for
+/// Set at build time (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape|draped|draped_clear cargo build
+/// --release`): run only that scene, the 128-node rod or the 512-vertex DFTL one, for
+/// [`PROFILE_STEPS`] steps calm and violent, or the draped 32-node rod strand of
+/// [`measure_collision_rows`] with its sphere or without, with [`step_begins`] and [`step_ends`] around each step, for
 /// `firmware/profile.py` to read a QEMU execution trace by (README, "Measured on the target").
 pub const PROFILE: Option<&str> = option_env!("HAIRSIM_PROFILE");
 
@@ -104,25 +105,28 @@ fn params(solver: Solver, shape: bool) -> Params {
 }
 
 /// Fills `world` with `strands` strands of `nodes` nodes (1 cm segments) rooted around a 5 cm
-/// head: hanging down (calm) or sticking out horizontally (violent).
+/// head (a sphere collider, unless `collider` is false): hanging down (calm) or sticking out
+/// horizontally (violent).
 fn build<const S: usize, const N: usize, M: Math>(
     world: &mut World<S, N, M>,
     solver: Solver,
     strands: usize,
     nodes: usize,
     violent: bool,
-    shape: bool,
+    (shape, collider): (bool, bool),
 ) -> bool {
     let mut ok = world.configure(params(solver, shape)).is_ok();
-    ok &= world
-        .add_collider(Collider {
-            shape: Shape::Sphere {
-                centre: Vec3::ZERO,
-                radius: 0.05,
-            },
-            attached_to_head: true,
-        })
-        .is_ok();
+    if collider {
+        ok &= world
+            .add_collider(Collider {
+                shape: Shape::Sphere {
+                    centre: Vec3::ZERO,
+                    radius: 0.05,
+                },
+                attached_to_head: true,
+            })
+            .is_ok();
+    }
     for s in 0..strands {
         let (sin, cos) = M::sin_cos(s as Real * 2.399_963);
         let out = Vec3::new(cos, 0.0, sin);
@@ -152,7 +156,7 @@ fn measure<const S: usize, const N: usize, M: Math>(
     let mut line = [(0u32, 0u32, 0u32); 2];
     for (v, violent) in [false, true].into_iter().enumerate() {
         *world = World::new();
-        if !build(world, solver, strands, nodes, violent, shape) {
+        if !build(world, solver, strands, nodes, violent, (shape, true)) {
             hprintln!(
                 "latency error: cannot build {} strands of {} nodes",
                 strands,
@@ -201,6 +205,89 @@ fn measure<const S: usize, const N: usize, M: Math>(
     );
 }
 
+/// What a collision row costs: a 32-node rod scene stepped [`STEPS`] times with its head's
+/// sphere and without it, the head shaking at 10 rad/s. Two scenes: the latency table's
+/// violent one (hair sticking out horizontally) and a draped one (one strand laid over the
+/// sphere from its equator round its top, as hair lies on a head). Prints, per scene, the
+/// ticks each run took in all and the collision rows the projection solved with the sphere
+/// (`StepReport::collision_rows`, summed); `firmware/latency.py` divides the modelled cycles
+/// the sphere adds by those rows.
+fn measure_collision_rows<const S: usize, const N: usize, M: Math>(world: &mut World<S, N, M>) {
+    let nodes = 32;
+    for draped in [false, true] {
+        let mut totals = [(0, 0); 2];
+        for (c, collider) in [true, false].into_iter().enumerate() {
+            match collision_scene(world, (nodes, STEPS), (draped, collider)) {
+                Some(total) => totals[c] = total,
+                None => return hprintln!("latency error: cannot build the collision rows' scene"),
+            }
+        }
+        hprintln!(
+            "collision rows rod {} nodes {} steps {} with {} without {} rows {}",
+            if draped { "draped" } else { "violent" },
+            nodes,
+            STEPS,
+            totals[0].0,
+            totals[1].0,
+            totals[0].1
+        );
+    }
+}
+
+/// Builds the collision rows' scene (`draped` or violent, with the sphere or without) in
+/// `world` and steps it `steps` times with the step markers; the ticks and collision rows it
+/// took in all, or `None` if it cannot be built.
+fn collision_scene<const S: usize, const N: usize, M: Math>(
+    world: &mut World<S, N, M>,
+    (nodes, steps): (usize, usize),
+    (draped, collider): (bool, bool),
+) -> Option<(u32, u32)> {
+    *world = World::new();
+    let strands = if draped { 0 } else { 1 };
+    let mut ok = build(world, Solver::Rod, strands, nodes, true, (false, collider));
+    if draped {
+        ok &= add_draped(world, nodes);
+    }
+    if !ok {
+        return None;
+    }
+    let mut total = (0u32, 0u32);
+    for k in 0..steps {
+        let time = (k + 1) as Real * world.params().dt;
+        let input = StepInput {
+            head: Shake::TEN_RAD_PER_S.pose_at::<M>(time),
+            accelerations: None,
+        };
+        let mut rows = 0;
+        let t = ticks(|| {
+            step_begins();
+            rows = world.step(&input).collision_rows;
+            step_ends();
+        });
+        total = (total.0.wrapping_add(t), total.1.wrapping_add(rows));
+    }
+    Some(total)
+}
+
+/// One strand of `nodes` nodes, 1 cm apart along a great circle 0.2 mm outside the 5 cm head,
+/// from its equator over its top (an arc of 1 cm per node).
+fn add_draped<const S: usize, const N: usize, M: Math>(
+    world: &mut World<S, N, M>,
+    nodes: usize,
+) -> bool {
+    let radius = 0.0502;
+    let mut points = [Vec3::ZERO; N];
+    for (i, p) in points.iter_mut().enumerate().take(nodes) {
+        let (sin, cos) = M::sin_cos(0.01 * i as Real / radius);
+        *p = Vec3::new(cos, sin, 0.0) * radius;
+    }
+    let material = &hairsim_core::Material::HUMAN_HAIR;
+    match Strand::<N>::from_polyline(&points[..nodes.min(N)], material) {
+        Ok(strand) => world.add_strand(strand).is_ok(),
+        Err(_) => false,
+    }
+}
+
 type RodWorld<M> = World<8, 32, M>;
 /// A world sized for one 16-node strand (the step's scratch arrays scale with the capacity).
 type SmallRodWorld<M> = World<1, 16, M>;
@@ -224,9 +311,15 @@ pub fn run() {
         Some("dftl_noshape") => {
             return measure(dftl, Solver::Dftl, (32, 16), false, PROFILE_STEPS);
         }
+        // The draped collision rows' scene, with its sphere and without (for a stage table of
+        // what the sphere adds): 200 steps, so that the hair has settled on the head.
+        Some(scene @ ("draped" | "draped_clear")) => {
+            let _ = collision_scene(rod, (32, STEPS), (true, scene == "draped"));
+            return;
+        }
         Some(other) => {
             return hprintln!(
-                "latency error: HAIRSIM_PROFILE={} (rod, dftl or dftl_noshape)",
+                "latency error: HAIRSIM_PROFILE={} (rod, dftl, dftl_noshape, draped or draped_clear)",
                 other
             );
         }
@@ -237,6 +330,7 @@ pub fn run() {
     for strands in [1, 2, 4, 8] {
         measure(rod, Solver::Rod, (strands, 32), false, STEPS);
     }
+    measure_collision_rows(rod);
     // DFTL with shape preservation (the scenes' default), then the same without it.
     for strands in [4, 8, 16, 32, 64] {
         measure(dftl, Solver::Dftl, (strands, 16), true, STEPS);

@@ -325,6 +325,14 @@ impl<const N: usize> Rows<N> {
         self.rows.get(..self.count).unwrap_or(&[])
     }
 
+    /// The collision rows at this iterate: those of the nodes in `contact_nodes`.
+    #[must_use]
+    pub fn collision_rows(&self) -> u32 {
+        let nodes = self.contact_nodes.iter().take(self.contact_count.min(N));
+        let rows = nodes.map(|&i| self.contacts.get(usize::from(i)).map_or(0, |c| c.count));
+        rows.map(u32::from).sum()
+    }
+
     /// The nodes with collision rows at this iterate, in increasing order.
     #[must_use]
     pub fn contact_nodes(&self) -> &[u16] {

@@ -261,6 +261,9 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 book.outcome.residual = book.rows.residual;
                 book.outcome.converged = book.rows.converged;
                 book.running = !(k == cap || (book.outcome.converged && !fixed_cost));
+                if book.running {
+                    book.outcome.collision_rows += book.rows.collision_rows();
+                }
                 any |= book.running;
             }
             if !any {

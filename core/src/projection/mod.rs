@@ -59,6 +59,9 @@ pub struct Outcome {
     pub converged: bool,
     /// Rows dropped at a singular pivot, summed over iterations.
     pub dropped_rows: u32,
+    /// Collision rows at the iterates a solve followed, summed over iterations
+    /// ([`constraints::Rows::collision_rows`]).
+    pub collision_rows: u32,
 }
 
 /// Scratch space of one projection: fixed arrays on the stack, nothing on the heap.
@@ -345,6 +348,7 @@ fn iterate<M: Math, const N: usize>(
         if k == cap || (outcome.converged && !layout.fixed_cost) {
             break;
         }
+        outcome.collision_rows += work.rows.collision_rows();
         match solve_and_move::<M, N>(strand, held, work) {
             Some((dropped, moved)) => {
                 outcome.dropped_rows += dropped;
@@ -846,6 +850,7 @@ fn record<M: Math, const N: usize>(
         report.cap_hits += 1;
         report.flags.insert(Flags::CAP_HIT);
     }
+    report.collision_rows += outcome.collision_rows;
     if outcome.dropped_rows > 0 {
         report.dropped_rows += outcome.dropped_rows;
         report.flags.insert(Flags::SINGULAR);

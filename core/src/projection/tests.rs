@@ -27,6 +27,14 @@ fn context(params: &Params, colliders: &[Collider]) -> StepContext {
     StepContext::new(params, Pose::IDENTITY, Pose::IDENTITY, colliders)
 }
 
+/// A sphere that does not move with the head.
+fn still_sphere(centre: Vec3, radius: Real) -> Collider {
+    Collider {
+        shape: Shape::Sphere { centre, radius },
+        attached_to_head: false,
+    }
+}
+
 /// A straight strand of `nodes` nodes 1 cm apart along `direction` from `root`.
 fn line(nodes: usize, root: Vec3, direction: Vec3) -> Strand<N> {
     let points: [Vec3; N] = core::array::from_fn(|i| root + direction * (0.01 * i as Real));
@@ -342,13 +350,7 @@ fn two_contacts_with_the_same_normal_are_dropped_not_divided_by() {
 
 #[test]
 fn fixed_cost_runs_the_cap_whatever_the_state() {
-    let sphere = Collider {
-        shape: Shape::Sphere {
-            centre: Vec3::new(0.05, -0.005, 0.0),
-            radius: 0.025,
-        },
-        attached_to_head: false,
-    };
+    let sphere = still_sphere(Vec3::new(0.05, -0.005, 0.0), 0.025);
     let effects = [Effect::Inextensibility, Effect::Collisions];
     let p = params(&effects, Mode::FixedCost, 6, 1.0e-6);
     let ctx = context(&p, &[sphere]);
@@ -598,6 +600,54 @@ fn a_node_just_outside_that_the_segments_pull_in_is_held_in_the_same_iteration()
     assert_eq!(iterations[0], iterations[1], "{iterations:?}");
 }
 
+/// `collision_rows` counts each collision row once per iterate a solve followed: in fixed-cost
+/// mode (no tentative rows) one iteration solves the rows of the nodes inside the sphere at
+/// the start, counted here from the positions; more iterations add the rows of their
+/// iterates; a strand clear of the collider has none.
+#[test]
+fn collision_rows_count_each_row_once_per_solved_iterate() {
+    let sphere = still_sphere(Vec3::new(0.05, -0.03, 0.0), 0.04);
+    let effects = [Effect::Inextensibility, Effect::Collisions];
+    let sunk = || {
+        let mut strand = line(20, Vec3::new(0.0, 0.02, 0.0), Vec3::X);
+        for i in 2..20 {
+            strand.state.position[i].y -= 0.02;
+        }
+        strand
+    };
+    let inside = (2..20)
+        .filter(|&i| {
+            sphere
+                .shape
+                .penetration::<Libm>(sunk().state.position[i])
+                .is_some()
+        })
+        .count() as u32;
+    assert!(inside > 3, "the test needs nodes inside: {inside}");
+    let mut rows = [0; 2];
+    for (k, cap) in [1, 6].into_iter().enumerate() {
+        let p = params(&effects, Mode::FixedCost, cap, 1.0e-6);
+        let ctx = context(&p, &[sphere]);
+        for kernel in 0..2 {
+            let (mut strand, mut report) = (sunk(), StepReport::default());
+            let outcome = if kernel == 0 {
+                project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report)
+            } else {
+                lanes::project_alone::<Libm, N>(&mut strand, &ctx, &mut report)
+            };
+            assert_eq!(outcome.collision_rows, report.collision_rows);
+            rows[k] = report.collision_rows;
+        }
+    }
+    assert_eq!(rows[0], inside);
+    assert!(rows[1] > rows[0] && rows[1] <= 6 * 18, "{rows:?}");
+    let p = params(&effects, Mode::FixedCost, 6, 1.0e-6);
+    let mut clear = line(20, Vec3::new(0.0, 0.2, 0.0), Vec3::X);
+    let mut report = StepReport::default();
+    project_constraints::<Libm, N>(&mut clear, &context(&p, &[sphere]), &[], 0, &mut report);
+    assert_eq!(report.collision_rows, 0);
+}
+
 /// The bits of what a projection leaves: positions, velocities, outcome and report (but its
 /// flags).
 fn projected_bits(strand: &Strand<N>, outcome: &Outcome, report: &StepReport) -> Vec<u32> {
@@ -605,6 +655,7 @@ fn projected_bits(strand: &Strand<N>, outcome: &Outcome, report: &StepReport) ->
     let mut bits: Vec<u32> = state.flat_map(|v| v.to_array().map(f32::to_bits)).collect();
     bits.extend([outcome.iterations, outcome.residual.to_bits()]);
     bits.extend([u32::from(outcome.converged), outcome.dropped_rows]);
+    bits.extend([outcome.collision_rows, report.collision_rows]);
     let measures = [
         report.residual,
         report.max_stretch,

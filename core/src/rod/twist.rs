@@ -465,7 +465,8 @@ pub fn newton_twist<P: Precision, const N: usize>(
             }
         }
         let largest = line_search(frames, rest, terms, &step[..segments], theta);
-        outcome.converged = largest <= settings.tolerance;
+        outcome.converged =
+            largest <= settings.tolerance || largest <= resolution(&theta[..segments]);
         if outcome.converged && !settings.fixed_cost {
             break;
         }
@@ -473,12 +474,24 @@ pub fn newton_twist<P: Precision, const N: usize>(
     outcome
 }
 
+/// The smallest update the angles `theta` can resolve, rad: `2 ε max |θ^j|`. The angles wind
+/// up along a bent strand (21 rad at the tip of Table 2's strands, where an `f32` step is
+/// 1.9e-6 rad), and below this an update is a rounding: a tolerance under it would be met by
+/// luck or not at all, and the iteration would chase it for its whole cap.
+fn resolution<R: Scalar>(theta: &[R]) -> R {
+    let largest = theta
+        .iter()
+        .fold(R::ZERO, |m, &t| if t.abs() > m { t.abs() } else { m });
+    R::of(2.0) * R::EPSILON * largest
+}
+
 /// The Newton twist's iteration cap and tolerance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NewtonSettings<R> {
     /// Most iterations.
     pub iterations: u16,
-    /// Stop when the largest angle update is at most this, rad (unless `fixed_cost`).
+    /// Stop when the largest angle update is at most this, rad, or within what the angles'
+    /// precision resolves (`2 ε max |θ^j|`), unless `fixed_cost`.
     pub tolerance: R,
     /// Always run `iterations` (bounded latency).
     pub fixed_cost: bool,
