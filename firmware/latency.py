@@ -87,18 +87,19 @@ def main():
         print(f"| {solver} | {nodes} | {k(calm)} | {k(violent)} | "
               f"{violent[2] / calm[1]:.3f} | {cycles / CLOCK_HZ * 1e6:.0f} | {'yes' if fits else 'no'} |")
     for line in open(log):
-        m = re.match(r"collision rows rod (\w+) nodes (\d+) steps (\d+) with (\d+) without (\d+) "
-                     r"rows (\d+)", line)
+        m = re.match(r"collision rows rod (\w+) nodes (\d+) steps (\d+) "
+                     r"with (\d+) without (\d+) rows (\d+)", line)
         if not m:
             continue
         scene = m.group(1)
         nodes, steps, with_, without, rows = (int(g) for g in m.groups()[1:])
         added = (with_ - without) * INSTRUCTIONS_PER_TICK * factor
         per_row = added / rows if rows else float("inf")
+        verdict = "met" if per_row <= COLLISION_ROW_GOAL else "missed"
         print(f"collision rows, rod {nodes} nodes {scene}, {steps} steps: {rows} rows "
               f"({rows / steps:.1f} a step); the sphere adds {added / steps:.0f} cycles a step, "
-              f"{per_row:.0f} a row against {COLLISION_ROW_GOAL:.1f} (1.5 x {COLLISION_ROW_FLOOR}): "
-              f"{'met' if per_row <= COLLISION_ROW_GOAL else 'missed'}")
+              f"{per_row:.0f} a row against {COLLISION_ROW_GOAL:.1f} "
+              f"(1.5 x {COLLISION_ROW_FLOOR}): {verdict}")
     for solver in ("rod", "dftl", "dftl_noshape"):
         print(f"largest {solver} scene within half a 1 ms tick at 168 MHz: "
               f"{best.get(solver, 0) or 'none of those measured'} nodes")

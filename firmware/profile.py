@@ -1,13 +1,13 @@
 #!/usr/bin/env python3
 """Where a step's instructions go on the Cortex-M4F: reads a QEMU execution trace of a
-profiling build (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape`, see `src/latency.rs`) and counts the
-instructions executed between the firmware's `step_begins` and `step_ends` markers, per
-function of the core (the innermost one, inlined or not) and per source line, and the
-dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or chained (against the
-static share `latency.py` assumes), and the executed mix by kind of instruction: floating-point
-arithmetic (flops, counting a multiply-accumulate as two), loads and stores, moves, integer work
-and branches (`docs/study/floors.md` sets the floating-point part against the models' floors),
-and the instructions per stage of the step.
+profiling build (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape|draped|draped_clear`, see
+`src/latency.rs`) and counts the instructions executed between the firmware's `step_begins`
+and `step_ends` markers, per function of the core (the innermost one, inlined or not) and per
+source line, and the dynamic share of VDIV/VSQRT and of the multiply-accumulates, fused or
+chained (against the static share `latency.py` assumes), and the executed mix by kind of
+instruction: floating-point arithmetic (flops, counting a multiply-accumulate as two), loads
+and stores, moves, integer work and branches (`docs/study/floors.md` sets the floating-point
+part against the models' floors), and the instructions per stage of the step.
 
     cd firmware && HAIRSIM_PROFILE=dftl_noshape cargo build --release
     qemu-system-arm -cpu cortex-m4 -machine mps2-an386 -nographic -icount shift=0 \\
@@ -124,7 +124,9 @@ def stage(core, pairs):
         return "libm (sincosf, fmaxf, fminf)"
     if outermost.startswith("elastic_forces"):
         return "elastic forces"
-    return "memory fills and copies (compiler-builtins)"
+    # compiler-builtins: memory fills and copies, and software `f64` (libm's `sincosf` works
+    # in `f64` for angles away from zero).
+    return "compiler-builtins (memory fills and copies, software f64)"
 
 
 def main():

@@ -20,10 +20,11 @@ const STEPS: usize = 200;
 const PROFILE_STEPS: usize = 6;
 
 /// Set at build time (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape|draped|draped_clear cargo build
-/// --release`): run only that scene, the 128-node rod or the 512-vertex DFTL one, for
-/// [`PROFILE_STEPS`] steps calm and violent, or the draped 32-node rod strand of
-/// [`measure_collision_rows`] with its sphere or without, with [`step_begins`] and [`step_ends`] around each step, for
-/// `firmware/profile.py` to read a QEMU execution trace by (README, "Measured on the target").
+/// --release`): run only that scene, with [`step_begins`] and [`step_ends`] around each step,
+/// for `firmware/profile.py` to read a QEMU execution trace by (README, "Measured on the
+/// target"): the 128-node rod or the 512-vertex DFTL one for [`PROFILE_STEPS`] steps calm and
+/// violent, or the draped 32-node rod strand of [`measure_collision_rows`] with its sphere or
+/// without for [`STEPS`] steps.
 pub const PROFILE: Option<&str> = option_env!("HAIRSIM_PROFILE");
 
 /// Marks where a measured step starts in an execution trace (a call never inlined away).
@@ -319,7 +320,7 @@ pub fn run() {
         }
         Some(other) => {
             return hprintln!(
-                "latency error: HAIRSIM_PROFILE={} (rod, dftl, dftl_noshape, draped or draped_clear)",
+                "latency error: HAIRSIM_PROFILE={} (rod, dftl, dftl_noshape, draped, draped_clear)",
                 other
             );
         }
