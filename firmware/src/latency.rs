@@ -169,21 +169,7 @@ fn measure<const S: usize, const N: usize, M: Math>(
         let all = unsafe { &mut *core::ptr::addr_of_mut!(TICKS) };
         let t = &mut all[..steps.clamp(1, STEPS)];
         for (k, slot) in t.iter_mut().enumerate() {
-            let time = (k + 1) as Real * world.params().dt;
-            let head = if violent {
-                Shake::TEN_RAD_PER_S.pose_at::<M>(time)
-            } else {
-                Pose::IDENTITY
-            };
-            let input = StepInput {
-                head,
-                accelerations: None,
-            };
-            *slot = ticks(|| {
-                step_begins();
-                world.step(&input);
-                step_ends();
-            });
+            *slot = timed_step(world, k, violent).0;
         }
         line[v] = stats(t);
     }
@@ -254,20 +240,36 @@ fn collision_scene<const S: usize, const N: usize, M: Math>(
     }
     let mut total = (0u32, 0u32);
     for k in 0..steps {
-        let time = (k + 1) as Real * world.params().dt;
-        let input = StepInput {
-            head: Shake::TEN_RAD_PER_S.pose_at::<M>(time),
-            accelerations: None,
-        };
-        let mut rows = 0;
-        let t = ticks(|| {
-            step_begins();
-            rows = world.step(&input).collision_rows;
-            step_ends();
-        });
+        let (t, rows) = timed_step(world, k, true);
         total = (total.0.wrapping_add(t), total.1.wrapping_add(rows));
     }
     Some(total)
+}
+
+/// Step `k` (from 0) of `world`, the head still or shaking at 10 rad/s (`violent`), between
+/// the step markers: its ticks and the collision rows its projection solved.
+fn timed_step<const S: usize, const N: usize, M: Math>(
+    world: &mut World<S, N, M>,
+    k: usize,
+    violent: bool,
+) -> (u32, u32) {
+    let time = (k + 1) as Real * world.params().dt;
+    let head = if violent {
+        Shake::TEN_RAD_PER_S.pose_at::<M>(time)
+    } else {
+        Pose::IDENTITY
+    };
+    let input = StepInput {
+        head,
+        accelerations: None,
+    };
+    let mut rows = 0;
+    let t = ticks(|| {
+        step_begins();
+        rows = world.step(&input).collision_rows;
+        step_ends();
+    });
+    (t, rows)
 }
 
 /// One strand of `nodes` nodes, 1 cm apart along a great circle 0.2 mm outside the 5 cm head,

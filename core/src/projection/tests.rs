@@ -615,13 +615,9 @@ fn collision_rows_count_each_row_once_per_solved_iterate() {
         }
         strand
     };
+    let start = sunk().state.position;
     let inside = (2..20)
-        .filter(|&i| {
-            sphere
-                .shape
-                .penetration::<Libm>(sunk().state.position[i])
-                .is_some()
-        })
+        .filter(|&i| sphere.shape.penetration::<Libm>(start[i]).is_some())
         .count() as u32;
     assert!(inside > 3, "the test needs nodes inside: {inside}");
     let mut rows = [0; 2];

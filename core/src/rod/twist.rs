@@ -406,10 +406,7 @@ fn line_search<P: Precision, const N: usize>(
         }
         if elastic_energy(frames, &trial[..segments], rest, terms) <= start {
             theta[..segments].copy_from_slice(&trial[..segments]);
-            let largest = step
-                .iter()
-                .fold(P::R::ZERO, |m, s| if s.abs() > m { s.abs() } else { m });
-            return largest * scale;
+            return largest_magnitude(step) * scale;
         }
         scale *= P::R::of(0.5);
     }
@@ -479,10 +476,13 @@ pub fn newton_twist<P: Precision, const N: usize>(
 /// 1.9e-6 rad), and below this an update is a rounding: a tolerance under it would be met by
 /// luck or not at all, and the iteration would chase it for its whole cap.
 fn resolution<R: Scalar>(theta: &[R]) -> R {
-    let largest = theta
-        .iter()
-        .fold(R::ZERO, |m, &t| if t.abs() > m { t.abs() } else { m });
-    R::of(2.0) * R::EPSILON * largest
+    R::of(2.0) * R::EPSILON * largest_magnitude(theta)
+}
+
+/// `max_j |x_j|` (0 for none).
+fn largest_magnitude<R: Scalar>(x: &[R]) -> R {
+    x.iter()
+        .fold(R::ZERO, |m, &v| if v.abs() > m { v.abs() } else { m })
 }
 
 /// The Newton twist's iteration cap and tolerance.
