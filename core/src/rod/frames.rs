@@ -208,30 +208,44 @@ pub const BINORMAL_MIN_WEIGHT: f32 = 1.0e-2;
 /// The direction `(cos φ, sin φ)`, defined mod π, that segment `j`'s material vector `m1`
 /// takes in the hair-optimised twist: the mean of the directions of the binormals at nodes `j`
 /// and `j + 1` in the Bishop frame of segment `j` (Kmoch Sec. 6.2), averaged as lines:
-/// `φ = ½ arg Σ w e^{2iη}`. `None` when both binormals (nearly) vanish. No trigonometry: the
-/// doubled angle is a complex square, the half angle a square root.
+/// `φ = ½ arg Σ w e^{2iη}`; with the angle `φ`. `None` when both binormals (nearly) vanish.
+/// The doubled angle is a complex square, the half angle's direction a square root.
 ///
 /// One division: the weights `1/r_k` are kept as a fraction `Σ z_k/r_k = sum / scale`, whose
 /// direction is that of `sum`, and the half angle of `z = X + iY` is `(|z| + X, Y)` (or
-/// `(Y, |z| − X)`, the same line, when `X < 0`), normalised once.
+/// `(Y, |z| − X)`, the same line, when `X < 0`), normalised once. The angle is the `atan2`
+/// of the half angle before it is normalised: it does not wait for the normalisation's square
+/// root and division, the longest chain of the twist's segment.
 #[inline(always)]
 #[must_use]
 pub fn binormal_direction<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     j: usize,
-) -> Option<[P::R; 2]> {
-    let (direction, some) = binormal_direction_in_lanes(frames, j);
-    some.then_some(direction)
+) -> Option<([P::R; 2], P::R)> {
+    let binormal = binormal_direction_in_lanes(frames, j);
+    binormal
+        .some
+        .then_some((binormal.direction, binormal.angle))
 }
 
-/// [`binormal_direction`] per lane: the direction, and where there is one (elsewhere the
-/// direction is not meaningful).
+/// [`binormal_direction`] per lane.
+#[derive(Clone, Copy, Debug)]
+pub struct BinormalDirection<R: Arithmetic> {
+    /// `(cos φ, sin φ)`.
+    pub direction: [R; 2],
+    /// `φ`.
+    pub angle: R,
+    /// Where there is a direction (elsewhere `direction` and `angle` are not meaningful).
+    pub some: R::Mask,
+}
+
+/// [`binormal_direction`] per lane.
 #[inline(always)]
 #[must_use]
-pub fn binormal_direction_in_lanes<P: Kernel, const N: usize>(
+pub fn binormal_direction_in_lanes<P: Trigonometry, const N: usize>(
     frames: &RodFrames<P, N>,
     j: usize,
-) -> ([P::R; 2], <P::R as Arithmetic>::Mask) {
+) -> BinormalDirection<P::R> {
     let n = frames.interior();
     let fade = P::R::of(BINORMAL_FADE);
     // Σ_k z_k / r_k with z_k = (a² − b², 2ab) and r_k = a² + b² + ε², as `sum / scale`.
@@ -261,7 +275,11 @@ pub fn binormal_direction_in_lanes<P: Kernel, const N: usize>(
     let bound = P::R::of(BINORMAL_MIN_WEIGHT) * scale;
     let some = !(weight2.le(bound * bound) | !weight2.finite());
     if !P::R::any(some) {
-        return ([P::R::ONE, P::R::ZERO], some);
+        return BinormalDirection {
+            direction: [P::R::ONE, P::R::ZERO],
+            angle: P::R::ZERO,
+            some,
+        };
     }
     let weight = P::sqrt(weight2);
     let right = P::R::ZERO.le(x);
@@ -269,13 +287,17 @@ pub fn binormal_direction_in_lanes<P: Kernel, const N: usize>(
         P::R::select(right, weight + x, y),
         P::R::select(right, y, weight - x),
     ];
+    // `atan2` is blind to the length: it takes the half angle as it is, beside the
+    // normalisation rather than after it.
+    let angle = P::atan2(half_angle[1], half_angle[0]);
     let inverse_length =
         P::R::ONE / P::sqrt(half_angle[0] * half_angle[0] + half_angle[1] * half_angle[1]);
-    (
-        [
+    BinormalDirection {
+        direction: [
             half_angle[0] * inverse_length,
             half_angle[1] * inverse_length,
         ],
+        angle,
         some,
-    )
+    }
 }

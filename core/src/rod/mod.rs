@@ -103,6 +103,7 @@ impl ClampedSegments {
     }
 
     /// The clamped segments other than the root, in insertion order.
+    #[inline]
     pub fn others(&self) -> impl Iterator<Item = usize> + '_ {
         self.segments[..self.count as usize]
             .iter()

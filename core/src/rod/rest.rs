@@ -87,10 +87,7 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         for j in 1..segments {
             let previous = self.rest_theta[j - 1];
             self.rest_theta[j] = match binormal_direction(frames, j) {
-                Some(direction) => {
-                    let phi = P::atan2(direction[1], direction[0]);
-                    representative_near::<P>(phi, direction, previous).0
-                }
+                Some((direction, phi)) => representative_near::<P>(phi, direction, previous).0,
                 None => previous,
             };
             self.rest_twist[j] = self.rest_theta[j] - self.rest_theta[j - 1];

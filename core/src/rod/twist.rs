@@ -85,27 +85,38 @@ fn local_bending<P: Kernel, const N: usize>(
 ) -> (P::R, P::R) {
     let n = frames.interior();
     let b = bending_matrix(rest, terms, j);
-    let half = P::R::of(0.5);
     let mut energies = (P::R::ZERO, P::R::ZERO);
-    let mut node = |i: usize, k: usize| {
-        let w = material_curvature(frames.bishop_curvature[i][k], cos_sin);
-        let r = rest.rest_curvature[i][k];
-        let scale = half * rest.inverse_voronoi_length[i];
-        let (d0, d1) = (w[0] - r[0], w[1] - r[1]);
-        let (f0, f1) = (w[0] + r[0], w[1] + r[1]);
-        energies.0 += (b[0] * d0 * d0 + b[1] * d1 * d1) * scale;
-        energies.1 += (b[0] * f0 * f0 + b[1] * f1 * f1) * scale;
-    };
     if j >= 1 && j <= n {
-        node(j, 1);
+        add_node_bending(frames, rest, b, (j, 1), cos_sin, &mut energies);
     }
     if j < n {
-        node(j + 1, 0);
+        add_node_bending(frames, rest, b, (j + 1, 0), cos_sin, &mut energies);
     }
     energies
 }
 
+/// [`local_bending`]'s term of node `i` (`k`: which of its two frames), added to `energies`.
+/// A function, not a closure: in lanes the compiler left the closure a call per node.
+#[inline(always)]
+fn add_node_bending<P: Kernel, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    b: [P::R; 2],
+    (i, k): (usize, usize),
+    cos_sin: [P::R; 2],
+    energies: &mut (P::R, P::R),
+) {
+    let w = material_curvature(frames.bishop_curvature[i][k], cos_sin);
+    let r = rest.rest_curvature[i][k];
+    let scale = P::R::of(0.5) * rest.inverse_voronoi_length[i];
+    let (d0, d1) = (w[0] - r[0], w[1] - r[1]);
+    let (f0, f1) = (w[0] + r[0], w[1] + r[1]);
+    energies.0 += (b[0] * d0 * d0 + b[1] * d1 * d1) * scale;
+    energies.1 += (b[0] * f0 * f0 + b[1] * f1 * f1) * scale;
+}
+
 /// The twist energy of nodes `j`, `j + 1` with `θ^j = candidate` and the neighbours' angles.
+#[inline(always)]
 fn local_twist<const N: usize, R: Arithmetic>(
     rest: &RodRest<N, R>,
     terms: ElasticTerms,
@@ -239,32 +250,18 @@ fn choose<P: Trigonometry, const N: usize>(
     let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
     // The current angle first: a candidate must be strictly lower to replace it.
     let kept = theta[j];
-    let mut best = (kept, prepared.kept_cos_sin);
-    let mut best_energy = prepared.kept_bending + twist(kept);
-    let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
-    let mut consider = |some, candidate: P::R, cos_sin: [P::R; 2], bending: P::R| {
-        let energy = bending + twist(candidate);
-        let lower = some & energy.lt(best_energy);
-        let blend = |m, a: Choice<P::R>, b: Choice<P::R>| Choice {
-            angle: P::R::select(m, a.angle, b.angle),
-            cos_sin: [0, 1].map(|k| P::R::select(m, a.cos_sin[k], b.cos_sin[k])),
-            energy: P::R::select(m, a.energy, b.energy),
-        };
-        let now = Choice {
-            angle: best.0,
-            cos_sin: best.1,
-            energy: best_energy,
-        };
-        let this = Choice {
-            angle: candidate,
-            cos_sin,
-            energy,
-        };
-        let chosen = select_whole::<P::R, _>(lower, this, now, blend);
-        best = (chosen.angle, chosen.cos_sin);
-        best_energy = chosen.energy;
+    let mut best = Choice {
+        angle: kept,
+        cos_sin: prepared.kept_cos_sin,
+        energy: prepared.kept_bending + twist(kept),
     };
-    consider(P::R::mask(true), reference, reference_cos_sin, continued);
+    let (continued, _) = local_bending(frames, rest, terms, j, reference_cos_sin);
+    let continuation = Choice {
+        angle: reference,
+        cos_sin: reference_cos_sin,
+        energy: continued + twist(reference),
+    };
+    best = lower_of::<P::R>(P::R::mask(true), continuation, best);
     let binormal = &prepared.binormal;
     if P::R::any(prepared.has_binormal) {
         let some = prepared.has_binormal;
@@ -276,11 +273,37 @@ fn choose<P: Trigonometry, const N: usize>(
         let aligned = P::R::select(odd, opposite, at);
         let flipped_bending = P::R::select(odd, at, opposite);
         let flipped = [-cos_sin[0], -cos_sin[1]];
-        consider(some, angle, cos_sin, aligned);
-        consider(some, angle + P::PI, flipped, flipped_bending);
-        consider(some, angle - P::PI, flipped, flipped_bending);
+        for (angle, cos_sin, bending) in [
+            (angle, cos_sin, aligned),
+            (angle + P::PI, flipped, flipped_bending),
+            (angle - P::PI, flipped, flipped_bending),
+        ] {
+            let energy = bending + twist(angle);
+            best = lower_of::<P::R>(
+                some,
+                Choice {
+                    angle,
+                    cos_sin,
+                    energy,
+                },
+                best,
+            );
+        }
     }
-    best
+    (best.angle, best.cos_sin)
+}
+
+/// `candidate` where `some` and its energy is strictly lower than `best`'s, else `best`,
+/// lane by lane.
+#[inline(always)]
+fn lower_of<R: Arithmetic>(some: R::Mask, candidate: Choice<R>, best: Choice<R>) -> Choice<R> {
+    let lower = some & candidate.energy.lt(best.energy);
+    let blend = |m, a: Choice<R>, b: Choice<R>| Choice {
+        angle: R::select(m, a.angle, b.angle),
+        cos_sin: [0, 1].map(|k| R::select(m, a.cos_sin[k], b.cos_sin[k])),
+        energy: R::select(m, a.energy, b.energy),
+    };
+    select_whole::<R, _>(lower, candidate, best, blend)
 }
 
 /// A candidate of the sweep: an angle, its cosine and sine, and its local energy.
@@ -350,12 +373,13 @@ impl<R: Arithmetic> Candidates<R> {
             let (s, c) = P::sin_cos(kept);
             [c, s]
         });
-        let (direction, has_binormal) = binormal_direction_in_lanes(frames, j);
+        let found = binormal_direction_in_lanes(frames, j);
+        let has_binormal = found.some;
         let binormal = if R::any(has_binormal) {
             Binormal {
-                direction,
-                angle: P::atan2(direction[1], direction[0]),
-                bending: local_bending(frames, rest, terms, j, direction),
+                direction: found.direction,
+                angle: found.angle,
+                bending: local_bending(frames, rest, terms, j, found.direction),
             }
         } else {
             Binormal::NONE
@@ -819,13 +843,19 @@ mod tests {
                     assert!(weight < min, "{trial}: weight {weight} but no direction");
                     none += 1;
                 }
-                Some([c, s]) => {
+                Some(([c, s], angle)) => {
                     assert!(weight > min, "{trial}: weight {weight} but a direction");
                     let phi = 0.5 * z[1].atan2(z[0]);
                     assert!(((c * c + s * s) - 1.0).abs() < 1e-12, "{trial}: not unit");
                     // The same line: the cross product of the two unit vectors vanishes.
                     let across = c * phi.sin() - s * phi.cos();
                     assert!(across.abs() < 1e-9, "{trial}: {c} {s} against φ = {phi}");
+                    // The angle is the direction's, not merely its line's.
+                    let (sin, cos) = angle.sin_cos();
+                    assert!(
+                        (cos - c).abs() < 1e-9 && (sin - s).abs() < 1e-9,
+                        "{trial}: angle {angle} against ({c}, {s})"
+                    );
                     checked += 1;
                 }
             }
