@@ -21,6 +21,7 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use hairsim::builtin;
 use hairsim::scene::Prepared;
 use hairsim::sim::{scene_inputs, Layout, Sim};
+use hairsim_core::params::TwistMethod;
 use hairsim_core::scenes::firmware;
 use hairsim_core::{Libm, World};
 
@@ -140,8 +141,14 @@ fn firmware_step(c: &mut Criterion) {
 /// than the slower one, and the ratio would compare different steps.
 fn rod_lanes(c: &mut Criterion) {
     let mut group = c.benchmark_group("Rod blocks against one strand at a time (ms per step)");
-    for name in ["head-1", "stand-1"] {
-        let prepared = prepared(name);
+    let mut newton = prepared("head-1");
+    newton.params.rod.twist = TwistMethod::Newton;
+    let scenes = [
+        ("head-1", prepared("head-1")),
+        ("head-1 newton", newton),
+        ("stand-1", prepared("stand-1")),
+    ];
+    for (name, prepared) in scenes {
         for (layout, label) in [
             (Layout::PerStrand, "per strand"),
             (Layout::Blocks, "blocks"),

@@ -45,6 +45,7 @@ mod rod_blocks {
     use hairsim_core::collide::{Collider, Shape};
     use hairsim_core::context::StepContext;
     use hairsim_core::hash::state_hash;
+    use hairsim_core::params::TwistMethod;
     use hairsim_core::rod::frames::RodFrames;
     use hairsim_core::rod::substeps::{plan, smallest_binormal_denominator, Integration};
     use hairsim_core::{
@@ -96,7 +97,7 @@ mod rod_blocks {
         Strand::from_polyline(&points, &material).unwrap()
     }
 
-    fn params(mode: Mode) -> Params {
+    fn params(mode: Mode, twist: TwistMethod) -> Params {
         let mut p = Params {
             effects: Effects::from_slice(&[
                 Effect::Gravity,
@@ -110,6 +111,7 @@ mod rod_blocks {
             ..Params::DEFAULT
         };
         p.mode = mode;
+        p.rod.twist = twist;
         p
     }
 
@@ -128,8 +130,8 @@ mod rod_blocks {
             .collect()
     }
 
-    fn check<M: Math, const W: usize>(mode: Mode) -> Cases {
-        let p = params(mode);
+    fn check<M: Math, const W: usize>(mode: Mode, twist: TwistMethod) -> Cases {
+        let p = params(mode, twist);
         let colliders = [Collider {
             shape: Shape::Sphere {
                 centre: Vec3::ZERO,
@@ -218,15 +220,16 @@ mod rod_blocks {
             }
         }
         assert_eq!(lanes, reference);
-        eprintln!("{mode:?}, {W} lanes: {cases:?}");
+        eprintln!("{mode:?}, {twist:?}, {W} lanes: {cases:?}");
         cases
     }
 
     #[test]
     fn blocks_give_the_per_strand_bits() {
+        let hair_optimised = TwistMethod::HairOptimised;
         for cases in [
-            check::<Libm, 4>(Mode::FixedCost),
-            check::<Libm, 8>(Mode::FixedCost),
+            check::<Libm, 4>(Mode::FixedCost, hair_optimised),
+            check::<Libm, 8>(Mode::FixedCost, hair_optimised),
         ] {
             assert!(cases.same_substeps > 0, "{cases:?}");
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
@@ -234,8 +237,8 @@ mod rod_blocks {
             assert!(cases.contacts > 0, "{cases:?}");
         }
         for cases in [
-            check::<Libm, 4>(Mode::Converge),
-            check::<Libm, 8>(Mode::Converge),
+            check::<Libm, 4>(Mode::Converge, hair_optimised),
+            check::<Libm, 8>(Mode::Converge, hair_optimised),
         ] {
             assert!(cases.same_substeps > 0, "{cases:?}");
             assert!(cases.different_substeps > 0, "{cases:?}");
@@ -244,6 +247,27 @@ mod rod_blocks {
             assert!(cases.roll_backs > 0, "{cases:?}");
             assert!(cases.grabbed > 0, "{cases:?}");
             assert!(cases.contacts > 0, "{cases:?}");
+        }
+    }
+
+    /// The same with Newton's twist, in lanes too: in converge mode each lane stops iterating
+    /// when its own update is small enough, and its angles stay as they are while the others
+    /// go on; in fixed-cost mode every lane runs the cap.
+    #[test]
+    fn blocks_give_the_per_strand_bits_with_the_newton_twist() {
+        let cases = check::<Libm, 4>(Mode::FixedCost, TwistMethod::Newton);
+        assert!(cases.same_substeps > 0, "{cases:?}");
+        assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+        assert!(cases.grabbed > 0 && cases.contacts > 0, "{cases:?}");
+        for cases in [
+            check::<Libm, 4>(Mode::Converge, TwistMethod::Newton),
+            check::<Libm, 8>(Mode::Converge, TwistMethod::Newton),
+        ] {
+            assert!(cases.different_substeps > 0, "{cases:?}");
+            assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+            assert!(cases.different_iterations > 0, "{cases:?}");
+            assert!(cases.roll_backs > 0, "{cases:?}");
+            assert!(cases.grabbed > 0 && cases.contacts > 0, "{cases:?}");
         }
     }
 }

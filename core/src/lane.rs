@@ -179,9 +179,14 @@ impl<const W: usize> Arithmetic for Wide<W> {
     type Mask = WideMask<W>;
     const ZERO: Self = Wide([0.0; W]);
     const ONE: Self = Wide([1.0; W]);
+    const EPSILON: Self = Wide([Real::EPSILON; W]);
     #[inline(always)]
     fn of(x: f32) -> Self {
         Wide([x; W])
+    }
+    #[inline(always)]
+    fn magnitude(self) -> Self {
+        <Self as Lane>::abs(self)
     }
     #[inline(always)]
     fn lt(self, other: Self) -> WideMask<W> {

@@ -25,7 +25,10 @@ use crate::rod::integrate::{starting_at, symplectic_euler, Nodes};
 use crate::rod::substeps::{
     inextensibility_between_substeps, smallest_binormal_denominator_in_lane, Integration,
 };
-use crate::rod::twist::{hair_optimised_twist_with_angles, ClampedFrames, TwistMethod};
+use crate::rod::twist::{
+    hair_optimised_twist_with_angles, newton_twist_in_lanes, ClampedFrames, NewtonSettings,
+    TwistMethod,
+};
 use crate::rod::{ClampedSegments, ElasticTerms};
 use crate::strand::Strand;
 
@@ -205,17 +208,15 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
             projection,
             report,
         );
-        // The hair-optimised twist in lanes for the strands in them that hold no segment but
-        // the root (a grabbed segment's saved frame is transported strand by strand).
+        // The twist in lanes for the strands in them that hold no segment but the root (a
+        // grabbed segment's saved frame is transported strand by strand).
         let in_lanes: [bool; W] = core::array::from_fn(|lane| {
             let free = self.begun[lane]
                 .as_ref()
                 .is_some_and(|b| b.clamped.others().next().is_none());
             free && self.gathered[lane]
         });
-        let lanes_twist = ctx.gates.twist
-            && ctx.params.rod.twist == TwistMethod::HairOptimised
-            && in_lanes.iter().filter(|&&l| l).count() > 1;
+        let lanes_twist = ctx.gates.twist && in_lanes.iter().filter(|&&l| l).count() > 1;
         if let (Some(block), true) = (self.block.as_mut(), lanes_twist) {
             twist_in_lanes(
                 block,
@@ -278,9 +279,10 @@ fn project<M: Math, const N: usize, const W: usize>(
 }
 
 /// Lines 9 (space) and 10 for the strands `in_lanes` names, in lanes: their new centrelines
-/// and root frames gathered, the lanes' frame pass, the hair-optimised twist, the angles
-/// scattered back. The same kernels as `super::rod::twist_alone` on each strand alone, with
-/// the angles its forces used (the block's, from the start of the step).
+/// and root frames gathered, the lanes' frame pass, the twist by the scene's method, the
+/// angles scattered back. The same kernels as `super::rod::twist_alone` on each strand alone,
+/// the hair-optimised twist with the angles its forces used (the block's, from the start of
+/// the step); each lane's Newton outcome reported as that strand's.
 fn twist_in_lanes<M: Math, const N: usize, const W: usize>(
     block: &mut LaneBlock<N, W>,
     frames: &mut RodFrames<Lanes<M, W>, N>,
@@ -303,7 +305,20 @@ fn twist_in_lanes<M: Math, const N: usize, const W: usize>(
         [ClampedSegments::ROOT_ONLY; W],
     );
     let theta = &mut block.theta[..segments];
-    hair_optimised_twist_with_angles(frames, &block.rest, &clamped, terms, theta, &block.cos_sin);
+    match ctx.params.rod.twist {
+        TwistMethod::HairOptimised => {
+            let cos_sin = &block.cos_sin;
+            hair_optimised_twist_with_angles(frames, &block.rest, &clamped, terms, theta, cos_sin);
+        }
+        TwistMethod::Newton => {
+            let settings = NewtonSettings::of(ctx);
+            let outcome =
+                newton_twist_in_lanes(frames, &block.rest, &clamped, terms, settings, theta);
+            for lane in (0..W).filter(|&lane| in_lanes[lane]) {
+                outcome.lane(lane).report(report);
+            }
+        }
+    }
     block.take_angles(strands, in_lanes);
 }
 

@@ -20,7 +20,7 @@
 
 pub use super::frames::{material_angles, material_curvature, representative_near, RodFrames};
 use super::{ClampedLanes, ClampedSegments, ElasticTerms};
-use crate::precision::{Arithmetic, Kernel, Precision, Vector};
+use crate::precision::{Arithmetic, Kernel, Precision, Trigonometry, Vector};
 use crate::strand::RodRest;
 
 /// `B^j = diag(µα^j, α^j)`, or zero when bending is off.
@@ -55,7 +55,7 @@ pub fn twist_stiffness<const N: usize, R: Arithmetic>(
 /// `1/(2 l̂_i) (ω − ω̂)ᵀ B^j (ω − ω̂)`.
 #[inline(always)]
 #[must_use]
-pub fn node_bending_energy<P: Precision, const N: usize>(
+pub fn node_bending_energy<P: Kernel, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,
@@ -87,7 +87,7 @@ pub fn node_twist_energy<const N: usize, R: Arithmetic>(
 
 /// The total elastic energy `E_bend + E_twist`, J.
 #[must_use]
-pub fn elastic_energy<P: Precision, const N: usize>(
+pub fn elastic_energy<P: Trigonometry, const N: usize>(
     frames: &RodFrames<P, N>,
     theta: &[P::R],
     rest: &RodRest<N, P::R>,
@@ -139,7 +139,7 @@ fn bending_terms<P: Kernel, const N: usize>(
 
 /// `∂E_bend/∂θ^j`: the bending part of the twist derivative (nodes `j` and `j + 1`).
 #[must_use]
-pub fn bending_twist_derivative<P: Precision, const N: usize>(
+pub fn bending_twist_derivative<P: Kernel, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,

@@ -180,7 +180,7 @@ impl<M: Math, const N: usize> RodFrames<M, N> {
 /// `(cos θ^j, sin θ^j)` per segment: the only trigonometry of a force evaluation, one call per
 /// segment (never per holonomy term or per Newton row).
 #[must_use]
-pub fn material_angles<P: Precision, const N: usize>(theta: &[P::R]) -> [[P::R; 2]; N] {
+pub fn material_angles<P: Trigonometry, const N: usize>(theta: &[P::R]) -> [[P::R; 2]; N] {
     let mut cos_sin = [[P::R::ONE, P::R::ZERO]; N];
     for (slot, t) in cos_sin.iter_mut().zip(theta) {
         let (s, c) = P::sin_cos(*t);

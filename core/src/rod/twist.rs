@@ -23,6 +23,7 @@ use super::{ClampedLanes, ClampedSegments, ElasticTerms};
 use crate::capacities::MAX_CLAMPED;
 use crate::context::StepContext;
 use crate::frames::{angle_in_frame, material_frame, parallel_transport, unwrap_near};
+use crate::lane::Wide;
 use crate::math::{Math, Real};
 use crate::params::Mode;
 use crate::precision::{select_whole, Arithmetic, Kernel, Precision, Scalar, Trigonometry, Vector};
@@ -58,16 +59,9 @@ pub fn update<M: Math, const N: usize>(
             hair_optimised_twist_with_angles(frames, rest, clamped, terms, theta, angles);
         }
         TwistMethod::Newton => {
-            let settings = NewtonSettings {
-                iterations: ctx.params.rod.newton_iterations,
-                tolerance: ctx.params.rod.newton_tolerance,
-                fixed_cost: ctx.params.mode == Mode::FixedCost,
-            };
+            let settings = NewtonSettings::of(ctx);
             let outcome = newton_twist(frames, rest, clamped, terms, settings, theta);
-            report.iterations_max = report.iterations_max.max(outcome.iterations);
-            if !outcome.converged {
-                report.flags.insert(Flags::CAP_HIT);
-            }
+            outcome.report(report);
         }
     }
 }
@@ -404,6 +398,39 @@ pub struct NewtonOutcome {
     pub gauss_newton: u32,
 }
 
+impl NewtonOutcome {
+    /// Into the step's report: the most iterations, and the cap hit when not converged.
+    pub fn report(self, report: &mut StepReport) {
+        report.iterations_max = report.iterations_max.max(self.iterations);
+        if !self.converged {
+            report.flags.insert(Flags::CAP_HIT);
+        }
+    }
+}
+
+/// [`NewtonOutcome`] per lane: the counts as reals (exact far past any iteration cap).
+#[derive(Clone, Copy, Debug)]
+pub struct NewtonLanes<R: Arithmetic> {
+    /// Newton iterations the lane ran.
+    pub iterations: R,
+    /// Whether the lane's last update was within the tolerance.
+    pub converged: R::Mask,
+    /// Iterations that fell back to Gauss–Newton in the lane.
+    pub gauss_newton: R,
+}
+
+impl<const W: usize> NewtonLanes<Wide<W>> {
+    /// Lane `lane`'s outcome.
+    #[must_use]
+    pub fn lane(&self, lane: usize) -> NewtonOutcome {
+        NewtonOutcome {
+            iterations: self.iterations.0[lane] as u32,
+            converged: self.converged.0[lane],
+            gauss_newton: self.gauss_newton.0[lane] as u32,
+        }
+    }
+}
+
 /// Largest Newton update of one angle, rad: far from the minimum a step of the quadratic model
 /// can overshoot by turns; a quarter turn keeps the iteration in the basin.
 const MAX_NEWTON_STEP: f32 = core::f32::consts::FRAC_PI_2;
@@ -412,45 +439,48 @@ const MAX_NEWTON_STEP: f32 = core::f32::consts::FRAC_PI_2;
 /// `θ ← θ − a·s` with the first `a = 1, ½, ¼, …` that does not raise `E`, so the iteration
 /// never climbs out of the current basin (without it, on a nearly straight strand with µ > 1,
 /// where the twist minimum is shallow, Gauss–Newton steps jump θ by radians from step to step).
-/// Returns the largest angle change made.
-fn line_search<P: Precision, const N: usize>(
+/// Lanes outside `active` keep their angles. Returns the largest angle change made, per lane.
+fn line_search<P: Trigonometry, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,
     step: &[P::R],
     theta: &mut [P::R],
+    active: <P::R as Arithmetic>::Mask,
 ) -> P::R {
     let segments = step.len().min(theta.len()).min(N);
     let mut trial = [P::R::ZERO; N];
     let start = elastic_energy(frames, &theta[..segments], rest, terms);
+    let longest = largest_magnitude(step);
     let mut scale = P::R::ONE;
+    // No decrease at any scale: θ is at the minimum to rounding, and the change is 0.
+    let mut largest = P::R::ZERO;
+    let mut searching = active;
     for _ in 0..=LINE_SEARCH_HALVINGS {
         for ((t, theta), s) in trial.iter_mut().zip(theta.iter()).zip(step) {
             *t = *theta - *s * scale;
         }
-        if elastic_energy(frames, &trial[..segments], rest, terms) <= start {
-            theta[..segments].copy_from_slice(&trial[..segments]);
-            return largest_magnitude(step) * scale;
+        let lower = searching & elastic_energy(frames, &trial[..segments], rest, terms).le(start);
+        if P::R::any(lower) {
+            for (theta, t) in theta[..segments].iter_mut().zip(&trial) {
+                *theta = P::R::select(lower, *t, *theta);
+            }
+            largest = P::R::select(lower, longest * scale, largest);
+            searching = searching & !lower;
+            if !P::R::any(searching) {
+                break;
+            }
         }
         scale *= P::R::of(0.5);
     }
-    // No decrease at any scale: θ is at the minimum to rounding.
-    P::R::ZERO
+    largest
 }
 
 /// Most halvings of a Newton step in [`line_search`].
 const LINE_SEARCH_HALVINGS: u32 = 4;
 
-/// BWR08's Newton twist: minimises `E` over the unclamped `θ^j` in place.
-///
-/// Bending is separable in `θ` and only twist couples neighbours, so the Hessian is
-/// tridiagonal: `H_jj = Σ_i (1/l̂_i)[(Jω)ᵀB(Jω) − ωᵀB(ω − ω̂)] + 2β/l̂_j + 2β/l̂_{j+1}`,
-/// `H_{j−1,j} = −2β/l̂_j`. Clamped segments are Dirichlet rows (an interior clamp splits the
-/// system). Far from rest `H_jj` can go negative: when the LDLᵀ of the full Hessian meets a
-/// non-positive pivot, the iteration uses Gauss–Newton (the `−ωᵀB(ω−ω̂)` term dropped, positive
-/// semi-definite plus the twist Laplacian), and every step is safeguarded by a backtracking
-/// line search on `E` (BWR08 leaves globalisation open). Stops when the largest update is `≤ tolerance` rad,
-/// unless `settings.fixed_cost`, which always runs `settings.iterations` (bounded latency).
+/// BWR08's Newton twist: minimises `E` over the unclamped `θ^j` in place
+/// ([`newton_twist_in_lanes`] on one strand).
 pub fn newton_twist<P: Precision, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
@@ -459,37 +489,64 @@ pub fn newton_twist<P: Precision, const N: usize>(
     settings: NewtonSettings<P::R>,
     theta: &mut [P::R],
 ) -> NewtonOutcome {
+    let outcome = newton_twist_in_lanes(frames, rest, clamped, terms, settings, theta);
+    NewtonOutcome {
+        iterations: outcome.iterations.to_f32() as u32,
+        converged: outcome.converged,
+        gauss_newton: outcome.gauss_newton.to_f32() as u32,
+    }
+}
+
+/// BWR08's Newton twist: minimises `E` over the unclamped `θ^j` in place, one strand or one
+/// per lane, each lane by the very operations it runs alone.
+///
+/// Bending is separable in `θ` and only twist couples neighbours, so the Hessian is
+/// tridiagonal: `H_jj = Σ_i (1/l̂_i)[(Jω)ᵀB(Jω) − ωᵀB(ω − ω̂)] + 2β/l̂_j + 2β/l̂_{j+1}`,
+/// `H_{j−1,j} = −2β/l̂_j`. Clamped segments are Dirichlet rows (an interior clamp splits the
+/// system). Far from rest `H_jj` can go negative: when the LDLᵀ of the full Hessian meets a
+/// non-positive pivot, the iteration uses Gauss–Newton (the `−ωᵀB(ω−ω̂)` term dropped, positive
+/// semi-definite plus the twist Laplacian), and every step is safeguarded by a backtracking
+/// line search on `E` (BWR08 leaves globalisation open). A lane stops when its largest update
+/// is `≤ tolerance` rad, unless `settings.fixed_cost`, which always runs `settings.iterations`
+/// (bounded latency); the others go on, and a lane that has stopped keeps its angles.
+pub fn newton_twist_in_lanes<P: Trigonometry, C: ClampedLanes<P::R>, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    clamped: &C,
+    terms: ElasticTerms,
+    settings: NewtonSettings<P::R>,
+    theta: &mut [P::R],
+) -> NewtonLanes<P::R> {
     let segments = frames.nodes.saturating_sub(1).min(theta.len());
-    let mut outcome = NewtonOutcome::default();
+    let (zero, one) = (P::R::ZERO, P::R::ONE);
+    let mut outcome = NewtonLanes {
+        iterations: zero,
+        converged: P::R::mask(false),
+        gauss_newton: zero,
+    };
     let mut system = NewtonSystem::<P::R, N>::default();
-    let mut step = [P::R::ZERO; N];
-    let mut pivots = [P::R::ONE; N];
+    let mut step = [zero; N];
+    let mut pivots = [one; N];
+    let mut active = P::R::mask(true);
+    let limit = P::R::of(MAX_NEWTON_STEP);
     for _ in 0..settings.iterations {
-        twist_newton_system(
-            frames,
-            rest,
-            clamped,
-            terms,
-            &theta[..segments],
-            &mut system,
-        );
-        outcome.iterations += 1;
-        if !system.solve(segments, &mut pivots, &mut step) {
-            outcome.gauss_newton += 1;
-        }
-        let limit = P::R::of(MAX_NEWTON_STEP);
+        let theta_now = &theta[..segments];
+        twist_newton_system(frames, rest, clamped, terms, theta_now, &mut system);
+        outcome.iterations += P::R::select(active, one, zero);
+        let full = system.solve(segments, &mut pivots, &mut step);
+        outcome.gauss_newton += P::R::select(active & !full, one, zero);
         for s in step[..segments].iter_mut() {
-            if *s > limit {
-                *s = limit;
-            } else if *s < -limit {
-                *s = -limit;
-            }
+            let below = P::R::select(s.lt(-limit), -limit, *s);
+            *s = P::R::select(limit.lt(*s), limit, below);
         }
-        let largest = line_search(frames, rest, terms, &step[..segments], theta);
-        outcome.converged =
-            largest <= settings.tolerance || largest <= resolution(&theta[..segments]);
-        if outcome.converged && !settings.fixed_cost {
-            break;
+        let largest = line_search(frames, rest, terms, &step[..segments], theta, active);
+        let converged = largest.le(settings.tolerance) | largest.le(resolution(&theta[..segments]));
+        outcome.converged = (active & converged) | (!active & outcome.converged);
+        if !settings.fixed_cost {
+            active = active & !converged;
+            if !P::R::any(active) {
+                break;
+            }
         }
     }
     outcome
@@ -499,14 +556,16 @@ pub fn newton_twist<P: Precision, const N: usize>(
 /// up along a bent strand (21 rad at the tip of Table 2's strands, where an `f32` step is
 /// 1.9e-6 rad), and below this an update is a rounding: a tolerance under it would be met by
 /// luck or not at all, and the iteration would chase it for its whole cap.
-fn resolution<R: Scalar>(theta: &[R]) -> R {
+fn resolution<R: Arithmetic>(theta: &[R]) -> R {
     R::of(2.0) * R::EPSILON * largest_magnitude(theta)
 }
 
 /// `max_j |x_j|` (0 for none).
-fn largest_magnitude<R: Scalar>(x: &[R]) -> R {
-    x.iter()
-        .fold(R::ZERO, |m, &v| if v.abs() > m { v.abs() } else { m })
+fn largest_magnitude<R: Arithmetic>(x: &[R]) -> R {
+    x.iter().fold(R::ZERO, |m, &v| {
+        let size = v.magnitude();
+        R::select(m.lt(size), size, m)
+    })
 }
 
 /// The Newton twist's iteration cap and tolerance.
@@ -519,6 +578,18 @@ pub struct NewtonSettings<R> {
     pub tolerance: R,
     /// Always run `iterations` (bounded latency).
     pub fixed_cost: bool,
+}
+
+impl<R: Arithmetic> NewtonSettings<R> {
+    /// The step's: the scene's cap and tolerance, every iteration in fixed-cost mode.
+    #[must_use]
+    pub fn of(ctx: &StepContext) -> Self {
+        NewtonSettings {
+            iterations: ctx.params.rod.newton_iterations,
+            tolerance: R::of(ctx.params.rod.newton_tolerance),
+            fixed_cost: ctx.params.mode == Mode::FixedCost,
+        }
+    }
 }
 
 /// The Newton system of the twist at some `θ` ([`twist_newton_system`]): the gradient
@@ -536,7 +607,7 @@ pub struct NewtonSystem<R, const N: usize> {
     pub coupling: [R; N],
 }
 
-impl<R: Scalar, const N: usize> Default for NewtonSystem<R, N> {
+impl<R: Arithmetic, const N: usize> Default for NewtonSystem<R, N> {
     fn default() -> Self {
         NewtonSystem {
             gradient: [R::ZERO; N],
@@ -547,45 +618,48 @@ impl<R: Scalar, const N: usize> Default for NewtonSystem<R, N> {
     }
 }
 
-impl<R: Scalar, const N: usize> NewtonSystem<R, N> {
+impl<R: Arithmetic, const N: usize> NewtonSystem<R, N> {
     /// The Newton step `s` of `H s = g` over the first `segments` rows (`pivots` as scratch).
     /// Where the full Hessian is not positive definite, the Gauss–Newton one instead: positive
-    /// definite whenever `β > 0`, once its non-positive entries are floored. Returns whether
-    /// the full Hessian served.
-    fn solve(&mut self, segments: usize, pivots: &mut [R; N], step: &mut [R; N]) -> bool {
+    /// definite whenever `β > 0`, once its non-positive entries are floored. Returns where
+    /// (which lanes) the full Hessian served.
+    fn solve(&mut self, segments: usize, pivots: &mut [R; N], step: &mut [R; N]) -> R::Mask {
         let rows = ..segments;
-        if solve_tridiagonal(
+        let full = solve_tridiagonal(
             &self.full[rows],
             &self.coupling[rows],
             &self.gradient[rows],
             &mut pivots[rows],
             &mut step[rows],
-        ) {
-            return true;
+        );
+        if R::all(full) {
+            return full;
         }
         for g in self.gauss_newton[rows].iter_mut() {
-            if *g <= R::ZERO || !g.is_finite() {
-                *g = R::of(1.0e-30);
-            }
+            *g = R::select(g.le(R::ZERO) | !g.finite(), R::of(1.0e-30), *g);
         }
+        let mut gauss_newton = [R::ZERO; N];
         solve_tridiagonal(
             &self.gauss_newton[rows],
             &self.coupling[rows],
             &self.gradient[rows],
             &mut pivots[rows],
-            &mut step[rows],
+            &mut gauss_newton[rows],
         );
-        false
+        for (s, g) in step[rows].iter_mut().zip(&gauss_newton) {
+            *s = R::select(full, *s, *g);
+        }
+        full
     }
 }
 
 /// The Newton system of the twist at `theta`: gradient `∂E/∂θ^j`, Hessian diagonal (full and
 /// Gauss–Newton) and the coupling `H_{j−1,j}` (stored at `j`). Clamped rows are identity rows
 /// with zero gradient and no coupling.
-pub fn twist_newton_system<P: Precision, const N: usize>(
+pub fn twist_newton_system<P: Trigonometry, C: ClampedLanes<P::R>, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
-    clamped: &ClampedSegments,
+    clamped: &C,
     terms: ElasticTerms,
     theta: &[P::R],
     system: &mut NewtonSystem<P::R, N>,
@@ -596,22 +670,24 @@ pub fn twist_newton_system<P: Precision, const N: usize>(
         gauss_newton,
         coupling,
     } = system;
+    let (zero, one) = (P::R::ZERO, P::R::ONE);
     let n = frames.interior().min(theta.len().saturating_sub(1));
     let two_beta = P::R::of(2.0) * twist_stiffness(rest, terms);
     let cos_sin = material_angles::<P, N>(theta);
     for j in 0..theta.len().min(N) {
-        coupling[j] = P::R::ZERO;
-        if clamped.contains(j) {
-            gradient[j] = P::R::ZERO;
-            full[j] = P::R::ONE;
-            gauss_newton[j] = P::R::ONE;
+        coupling[j] = zero;
+        let held = clamped.clamped(j);
+        if P::R::all(held) {
+            gradient[j] = zero;
+            full[j] = one;
+            gauss_newton[j] = one;
             continue;
         }
-        gradient[j] = bending_twist_derivative(frames, rest, terms, j, cos_sin[j])
+        let g = bending_twist_derivative(frames, rest, terms, j, cos_sin[j])
             + twist_twist_derivative(rest, terms, theta, j, n);
         // Per node i touching segment j: (Jω)ᵀB(Jω)/l̂_i, ωᵀB(ω−ω̂)/l̂_i and 2β/l̂_i.
         let b = bending_matrix(rest, terms, j);
-        let node = |i: usize, k: usize| {
+        let node = |(i, k): (usize, usize)| {
             let omega = material_curvature(frames.bishop_curvature[i][k], cos_sin[j]);
             let rest_omega = rest.rest_curvature[i][k];
             let inv_l = rest.inverse_voronoi_length[i];
@@ -621,42 +697,44 @@ pub fn twist_newton_system<P: Precision, const N: usize>(
                 * inv_l;
             (gn + two_beta * inv_l, curvature)
         };
-        let mut gn = P::R::ZERO;
-        let mut curvature = P::R::ZERO;
+        let mut gn = zero;
+        let mut curvature = zero;
         if j >= 1 && j <= n {
-            let (g, c) = node(j, 1);
+            let (g, c) = node((j, 1));
             gn += g;
             curvature += c;
-            if !clamped.contains(j - 1) {
-                coupling[j] = -two_beta * rest.inverse_voronoi_length[j];
-            }
+            let free = !clamped.clamped(j - 1);
+            let coupled = -two_beta * rest.inverse_voronoi_length[j];
+            coupling[j] = P::R::select(held | !free, zero, coupled);
         }
         if j < n {
-            let (g, c) = node(j + 1, 0);
+            let (g, c) = node((j + 1, 0));
             gn += g;
             curvature += c;
         }
-        gauss_newton[j] = gn;
-        full[j] = gn - curvature;
+        gradient[j] = P::R::select(held, zero, g);
+        gauss_newton[j] = P::R::select(held, one, gn);
+        full[j] = P::R::select(held, one, gn - curvature);
     }
 }
 
 /// Solves the symmetric tridiagonal system `H s = g` (diagonal `diagonal`, `H_{j−1,j} =
-/// coupling[j]`) by LDLᵀ (Thomas), O(n), with `pivots` as scratch. Returns `false` at a
-/// non-positive pivot (not positive definite), with `solution` zeroed.
-pub fn solve_tridiagonal<R: Scalar>(
+/// coupling[j]`) by LDLᵀ (Thomas), O(n), with `pivots` as scratch, in each lane. Returns where
+/// every pivot was positive (positive definite); elsewhere `solution` is zeroed.
+pub fn solve_tridiagonal<R: Arithmetic>(
     diagonal: &[R],
     coupling: &[R],
     rhs: &[R],
     pivots: &mut [R],
     solution: &mut [R],
-) -> bool {
+) -> R::Mask {
     let len = diagonal
         .len()
         .min(coupling.len())
         .min(rhs.len())
         .min(pivots.len())
         .min(solution.len());
+    let mut definite = R::mask(true);
     // Forward: pivots d_j = H_jj − H_{j−1,j}²/d_{j−1}, y_j = g_j − (H_{j−1,j}/d_{j−1}) y_{j−1}.
     for j in 0..len {
         let (pivot, y) = if j == 0 {
@@ -665,11 +743,13 @@ pub fn solve_tridiagonal<R: Scalar>(
             let l = coupling[j] / pivots[j - 1];
             (diagonal[j] - l * coupling[j], rhs[j] - l * solution[j - 1])
         };
-        if !(pivot > R::ZERO && pivot.is_finite()) {
+        definite = definite & R::ZERO.lt(pivot) & pivot.finite();
+        // No lane left to solve: stop at its first bad pivot.
+        if !R::any(definite) {
             for s in solution.iter_mut().take(len) {
                 *s = R::ZERO;
             }
-            return false;
+            return definite;
         }
         pivots[j] = pivot;
         solution[j] = y;
@@ -682,7 +762,12 @@ pub fn solve_tridiagonal<R: Scalar>(
         }
         solution[j] = y / pivots[j];
     }
-    true
+    if !R::all(definite) {
+        for s in solution.iter_mut().take(len) {
+            *s = R::select(definite, *s, R::ZERO);
+        }
+    }
+    definite
 }
 
 /// The material vectors `m1^c` of the clamped segments other than the root, saved before a
