@@ -16,9 +16,10 @@ use hairsim_core::context::StepContext;
 use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
+use hairsim_core::projection::lanes::BlockProjection;
 use hairsim_core::{
-    step_blocks, step_strands, step_strands_in_lanes, Collider, Grab, Math, Params, Pose, Real,
-    Solver, Stage, StepReport, Strand, Vec3,
+    step_blocks, step_strands, step_strands_in_lanes, step_strands_in_lanes_with, Collider, Grab,
+    Math, Params, Pose, Real, Solver, Stage, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -91,6 +92,9 @@ pub struct Sim<const N: usize, M: Math> {
     accelerations: Vec<Vec3>,
     /// One report per block of strands, reused every step (a step allocates nothing).
     block_reports: Vec<StepReport>,
+    /// The rod in lanes: the projection's scratch space of each block of strands, kept from
+    /// step to step (none for other solvers and layouts).
+    rod_scratch: Vec<Option<Box<BlockProjection<N, ROD_LANES>>>>,
     pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     math: std::marker::PhantomData<M>,
 }
@@ -138,9 +142,13 @@ impl<const N: usize, M: Math> Sim<N, M> {
                 .collect(),
             _ => Vec::new(),
         };
+        let blocks = strands.len().div_ceil(block);
+        let in_lanes = prepared.params.solver == Solver::Rod && layout == Layout::Blocks;
+        let rod_scratch = (0..blocks).map(|_| in_lanes.then(Box::default)).collect();
         Ok(Sim {
             params: prepared.params,
-            block_reports: vec![StepReport::default(); strands.len().div_ceil(block)],
+            block_reports: vec![StepReport::default(); blocks],
+            rod_scratch,
             accelerations: if sph.is_some() {
                 vec![Vec3::ZERO; strands.len() * N]
             } else {
@@ -252,7 +260,8 @@ impl<const N: usize, M: Math> Sim<N, M> {
         let reports = &mut self.block_reports;
         let parallel = self.pool.as_ref().filter(|_| reports.len() > 1);
         if self.dftl_blocks.is_empty() {
-            blocks.per_strand::<N, M>(&mut self.strands, reports, parallel);
+            let scratch = &mut self.rod_scratch;
+            blocks.per_strand::<N, M>(&mut self.strands, reports, scratch, parallel);
         } else {
             blocks.soa::<N, M>(&mut self.strands, &mut self.dftl_blocks, reports, parallel);
         }
@@ -281,36 +290,48 @@ impl Blocks<'_> {
             .and_then(|a| a.get(first * N..(first + strands) * N))
     }
 
-    /// Every block of `strands` through the core's per-strand pipeline.
+    /// Every block of `strands` through the core's per-strand pipeline, the rod's in lanes
+    /// with each block's projection scratch of `scratch` (as many as `reports`).
     fn per_strand<const N: usize, M: Math>(
         &self,
         strands: &mut [Strand<N>],
         reports: &mut [StepReport],
+        scratch: &mut [Option<Box<BlockProjection<N, ROD_LANES>>>],
         parallel: Option<&std::sync::Arc<rayon::ThreadPool>>,
     ) {
-        let step = |b: usize, strands: &mut [Strand<N>], r: &mut StepReport| {
+        type Scratch<const N: usize> = Option<Box<BlockProjection<N, ROD_LANES>>>;
+        let step = |b: usize,
+                    strands: &mut [Strand<N>],
+                    (r, s): (&mut StepReport, &mut Scratch<N>)| {
             *r = StepReport::default();
             let acc = self.of_block::<N>(b, strands.len());
             let first = (b * self.block) as u32;
             let (ctx, grabs) = (self.ctx, self.grabs);
-            if self.lanes {
-                type L<M> = VectorSqrt<M>;
-                step_strands_in_lanes::<L<M>, N, ROD_LANES>(ctx, strands, first, grabs, acc, r);
-            } else {
-                step_strands::<M, N>(ctx, strands, first, grabs, acc, r);
+            type L<M> = VectorSqrt<M>;
+            match (self.lanes, s) {
+                (true, Some(projection)) => {
+                    let at = (first, grabs);
+                    step_strands_in_lanes_with::<L<M>, N, ROD_LANES>(
+                        ctx, strands, at, acc, projection, r,
+                    );
+                }
+                (true, None) => {
+                    step_strands_in_lanes::<L<M>, N, ROD_LANES>(ctx, strands, first, grabs, acc, r);
+                }
+                (false, _) => step_strands::<M, N>(ctx, strands, first, grabs, acc, r),
             }
         };
         match parallel {
             Some(pool) => pool.install(|| {
-                let blocks = strands
-                    .par_chunks_mut(self.block)
-                    .zip(reports.par_iter_mut());
+                let per_block = reports.par_iter_mut().zip(scratch.par_iter_mut());
+                let blocks = strands.par_chunks_mut(self.block).zip(per_block);
                 blocks
                     .enumerate()
                     .for_each(|(b, (strands, r))| step(b, strands, r));
             }),
             None => {
-                let blocks = strands.chunks_mut(self.block).zip(reports.iter_mut());
+                let per_block = reports.iter_mut().zip(scratch.iter_mut());
+                let blocks = strands.chunks_mut(self.block).zip(per_block);
                 for (b, (strands, r)) in blocks.enumerate() {
                     step(b, strands, r);
                 }
