@@ -39,8 +39,8 @@ fn glam_math_goes_through_libm() {
 /// into one strand's velocity); a grab holds a node of one strand throughout (its clamped
 /// segment steps that strand's twist and its projection alone), and the head's sphere
 /// touches the strands (contacts found and eliminated lane by lane). The report's projection
-/// findings must match too. The twist is the hair-optimised one (the default), in lanes.
-/// Each of those cases is counted and must have occurred.
+/// findings must match too. The twist runs in lanes: the hair-optimised one (the default),
+/// and Newton's in a test of its own. Each of those cases is counted and must have occurred.
 mod rod_blocks {
     use hairsim_core::collide::{Collider, Shape};
     use hairsim_core::context::StepContext;
