@@ -419,15 +419,28 @@ pub struct NewtonLanes<R: Arithmetic> {
     pub gauss_newton: R,
 }
 
+impl<R: Scalar> NewtonLanes<R> {
+    /// The one lane's outcome.
+    #[must_use]
+    pub fn outcome(self) -> NewtonOutcome {
+        NewtonOutcome {
+            iterations: self.iterations.to_f32() as u32,
+            converged: self.converged,
+            gauss_newton: self.gauss_newton.to_f32() as u32,
+        }
+    }
+}
+
 impl<const W: usize> NewtonLanes<Wide<W>> {
     /// Lane `lane`'s outcome.
     #[must_use]
     pub fn lane(&self, lane: usize) -> NewtonOutcome {
-        NewtonOutcome {
-            iterations: self.iterations.0[lane] as u32,
+        NewtonLanes {
+            iterations: self.iterations.0[lane],
             converged: self.converged.0[lane],
-            gauss_newton: self.gauss_newton.0[lane] as u32,
+            gauss_newton: self.gauss_newton.0[lane],
         }
+        .outcome()
     }
 }
 
@@ -489,12 +502,7 @@ pub fn newton_twist<P: Precision, const N: usize>(
     settings: NewtonSettings<P::R>,
     theta: &mut [P::R],
 ) -> NewtonOutcome {
-    let outcome = newton_twist_in_lanes(frames, rest, clamped, terms, settings, theta);
-    NewtonOutcome {
-        iterations: outcome.iterations.to_f32() as u32,
-        converged: outcome.converged,
-        gauss_newton: outcome.gauss_newton.to_f32() as u32,
-    }
+    newton_twist_in_lanes(frames, rest, clamped, terms, settings, theta).outcome()
 }
 
 /// BWR08's Newton twist: minimises `E` over the unclamped `θ^j` in place, one strand or one
