@@ -163,12 +163,18 @@ pub fn sin_cos(x: Real) -> (Real, Real) {
     let [c0, c1, c2] = COS_COEFFICIENTS;
     let sin = r + r * z * (s0 + z * (s1 + z * s2));
     let cos = (1.0 - 0.5 * z) + z * z * (c0 + z * (c1 + z * c2));
-    match n & 3 {
-        0 => (sin, cos),
-        1 => (cos, -sin),
-        2 => (-sin, -cos),
-        _ => (-cos, sin),
-    }
+    // The quadrant by selects, not a jump: along a twisted strand it changes from segment to
+    // segment, which a branch predictor cannot follow. An odd `n` turns `(sin, cos)` by π/2
+    // into `(cos, −sin)`, and `n & 2` by π more, negating both (the `match` on `n & 3` it
+    // replaces gave the same values).
+    let odd = n & 1 != 0;
+    let (sin, cos) = (if odd { cos } else { sin }, if odd { -sin } else { cos });
+    let half_turn = n & 2 != 0;
+    let (sin, cos) = (
+        if half_turn { -sin } else { sin },
+        if half_turn { -cos } else { cos },
+    );
+    (sin, cos)
 }
 
 /// `atan(t) / t = Σ a_k u^k` with `u = t² ∈ [0, 1]`, lowest power first: a Chebyshev fit of

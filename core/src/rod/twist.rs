@@ -12,7 +12,7 @@
 //! by the time-parallel transport of their material frame.
 
 use super::energy::{
-    bending_matrix, bending_twist_derivative, elastic_energy, node_twist_energy, twist_stiffness,
+    bending_matrix, bending_twist_derivative, elastic_energy, twist_stiffness,
     twist_twist_derivative,
 };
 use super::frames::{
@@ -109,24 +109,54 @@ fn add_node_bending<P: Kernel, const N: usize>(
     energies.1 += (b[0] * f0 * f0 + b[1] * f1 * f1) * scale;
 }
 
-/// The twist energy of nodes `j`, `j + 1` with `θ^j = candidate` and the neighbours' angles.
+/// The twist energy of nodes `j`, `j + 1` with `θ^j = candidate`, the neighbours' angles as
+/// `reference = θ^{j−1} + m̂_j` and `next = θ^{j+1} − m̂_{j+1}`: `w₀(θ^j − reference)² +
+/// w₁(next − θ^j)²`, `w` = [`TwistWeights`]. These are the terms of `E`
+/// ([`super::energy::node_twist_energy`]) with the rest twist taken into the neighbours' angles
+/// once per segment, not once per candidate.
 #[inline(always)]
-fn local_twist<const N: usize, R: Arithmetic>(
-    rest: &RodRest<N, R>,
-    terms: ElasticTerms,
-    theta: &[R],
-    j: usize,
-    n: usize,
-    candidate: R,
-) -> R {
-    let mut energy = R::ZERO;
-    if j >= 1 && j <= n {
-        energy += node_twist_energy(rest, terms, j, theta[j - 1], candidate);
+fn local_twist<R: Arithmetic>(weights: &TwistWeights<R>, reference: R, candidate: R) -> R {
+    let (before, after) = (candidate - reference, weights.next - candidate);
+    weights.weight[0] * before * before + weights.weight[1] * after * after
+}
+
+/// What [`local_twist`] needs of segment `j` that does not depend on the sweep.
+#[derive(Clone, Copy, Debug)]
+struct TwistWeights<R> {
+    /// `β/l̂_j` where node `j` is interior (`1 ≤ j ≤ n`), `β/l̂_{j+1}` where node `j + 1` is
+    /// (`j < n`); 0 where not.
+    weight: [R; 2],
+    /// `θ^{j+1} − m̂_{j+1}` (0 past the tip), the angle segment `j + 1` has when the sweep
+    /// reaches `j`: it comes later.
+    next: R,
+}
+
+impl<R: Arithmetic> TwistWeights<R> {
+    /// Segment `j`'s, with `θ = theta` as the sweep reaches it (`n` interior nodes).
+    #[inline(always)]
+    fn of<const N: usize>(
+        rest: &RodRest<N, R>,
+        terms: ElasticTerms,
+        theta: &[R],
+        j: usize,
+        n: usize,
+    ) -> Self {
+        let beta = twist_stiffness(rest, terms);
+        let interior = |i: usize| i >= 1 && i <= n;
+        let weight = [j, j + 1].map(|i| {
+            if interior(i) {
+                beta * rest.inverse_voronoi_length[i]
+            } else {
+                R::ZERO
+            }
+        });
+        let next = if interior(j + 1) {
+            theta[j + 1] - rest.rest_twist[j + 1]
+        } else {
+            R::ZERO
+        };
+        TwistWeights { weight, next }
     }
-    if j < n {
-        energy += node_twist_energy(rest, terms, j + 1, candidate, theta[j + 1]);
-    }
-    energy
 }
 
 /// Kmoch 2009 Sec. 6.2, the hair-optimised twist, in place on `theta` (length ≥ segments):
@@ -139,9 +169,9 @@ pub fn hair_optimised_twist<P: Precision, const N: usize>(
     terms: ElasticTerms,
     theta: &mut [P::R],
 ) {
-    let segments = frames.nodes.saturating_sub(1).min(theta.len());
-    let current = material_angles::<P, N>(&theta[..segments]);
-    hair_optimised_twist_with_angles(frames, rest, clamped, terms, theta, &current);
+    // No angles given: the sweep takes each segment's `sin_cos` as it reaches it, beside the
+    // previous segment's choice rather than in a pass before the sweep.
+    hair_optimised_twist_with_angles(frames, rest, clamped, terms, theta, &[]);
 }
 
 /// Kmoch 2009 Sec. 6.2, the hair-optimised twist, in place on `theta`; `current[j]` holds
@@ -183,27 +213,24 @@ pub fn hair_optimised_twist_with_angles<P: Trigonometry, C: ClampedLanes<P::R>, 
         return;
     }
     let n = frames.interior().min(segments - 1);
-    // Two passes. The first computes everything that does not depend on the angles the sweep
-    // chooses: the binormal directions with their `atan2` and the candidates' bending
-    // energies. With nothing linking one segment to the next, the processor overlaps them.
-    // The second is the sweep root → tip, which only compares (see [`Candidates`]). A clamped
-    // segment's candidates are computed and not used (lanes: another strand's may be free).
-    let mut prepared = [Candidates::<P::R>::none(); N];
-    for (j, slot) in prepared.iter_mut().enumerate().take(segments).skip(1) {
-        if !P::R::all(clamped.clamped(j)) {
-            *slot = Candidates::of(frames, rest, terms, j, theta[j], current.get(j).copied());
-        }
-    }
     // (cos θ^{j−1}, sin θ^{j−1}), carried down the strand: one sin_cos per strand (and per
     // clamped segment), none per node.
     let (s, c) = P::sin_cos(theta[0]);
     let mut previous = [c, s];
-    for (j, prepared) in prepared.iter().enumerate().take(segments).skip(1) {
+    for j in 1..segments {
+        // One pass. A segment's candidates (its binormal direction with the `atan2`, their
+        // bending energies) do not depend on the angles the sweep chooses, so the processor
+        // computes them while the previous segment's choice completes; computed in a pass of
+        // their own before the sweep, the twist took 1.2× the time (Table 2's bench). A
+        // clamped segment's candidates are computed and not used (lanes: another strand's
+        // segment may be free).
         let held = clamped.clamped(j);
         let (chosen, chosen_cos_sin) = if P::R::all(held) {
             (theta[j], [P::R::ONE, P::R::ZERO])
         } else {
-            choose(rest, terms, frames, theta, j, n, prepared, previous)
+            let at = (&*theta, j, n);
+            let prepared = Candidates::of(frames, rest, terms, at, current.get(j).copied());
+            choose(rest, terms, frames, theta, j, &prepared, previous)
         };
         if P::R::any(held) {
             let (s, c) = P::sin_cos(theta[j]);
@@ -223,14 +250,12 @@ pub fn hair_optimised_twist_with_angles<P: Trigonometry, C: ClampedLanes<P::R>, 
 /// `(cos θ^{j−1}, sin θ^{j−1})` = `previous`: the candidate of least local energy, the current
 /// angle winning ties. Returns the angle and its cosine and sine.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)] // the sweep's state at one segment
 fn choose<P: Trigonometry, const N: usize>(
     rest: &RodRest<N, P::R>,
     terms: ElasticTerms,
     frames: &RodFrames<P, N>,
     theta: &[P::R],
     j: usize,
-    n: usize,
     prepared: &Candidates<P::R>,
     previous: [P::R; 2],
 ) -> (P::R, [P::R; 2]) {
@@ -241,7 +266,7 @@ fn choose<P: Trigonometry, const N: usize>(
         previous[0] * cm - previous[1] * sm,
         previous[1] * cm + previous[0] * sm,
     ];
-    let twist = |candidate| local_twist(rest, terms, theta, j, n, candidate);
+    let twist = |candidate| local_twist(&prepared.twist, reference, candidate);
     // The current angle first: a candidate must be strictly lower to replace it.
     let kept = theta[j];
     let mut best = Choice {
@@ -264,25 +289,24 @@ fn choose<P: Trigonometry, const N: usize>(
         // `ω(θ + π) = −ω(θ)`: the flipped representative swaps the two energies (the same
         // bits: negation is exact and rounding symmetric).
         let (at, opposite) = binormal.bending;
-        let aligned = P::R::select(odd, opposite, at);
+        let aligned = Choice {
+            angle,
+            cos_sin,
+            energy: P::R::select(odd, opposite, at) + twist(angle),
+        };
+        best = lower_of::<P::R>(some, aligned, best);
+        // `θ + π` and `θ − π` have the same bending energy: only the one of less twist can
+        // win, and it is taken as the paper's order would (`+π` first, `−π` if lower still).
         let flipped_bending = P::R::select(odd, at, opposite);
-        let flipped = [-cos_sin[0], -cos_sin[1]];
-        for (angle, cos_sin, bending) in [
-            (angle, cos_sin, aligned),
-            (angle + P::PI, flipped, flipped_bending),
-            (angle - P::PI, flipped, flipped_bending),
-        ] {
-            let energy = bending + twist(angle);
-            best = lower_of::<P::R>(
-                some,
-                Choice {
-                    angle,
-                    cos_sin,
-                    energy,
-                },
-                best,
-            );
-        }
+        let (up, down) = (angle + P::PI, angle - P::PI);
+        let (up_energy, down_energy) = (flipped_bending + twist(up), flipped_bending + twist(down));
+        let lower = down_energy.lt(up_energy);
+        let flipped = Choice {
+            angle: P::R::select(lower, down, up),
+            cos_sin: [-cos_sin[0], -cos_sin[1]],
+            energy: P::R::select(lower, down_energy, up_energy),
+        };
+        best = lower_of::<P::R>(some, flipped, best);
     }
     (best.angle, best.cos_sin)
 }
@@ -310,7 +334,8 @@ struct Choice<R> {
 
 /// What the hair-optimised sweep needs of one segment that does not depend on the angles it
 /// chooses before it: the current angle's cosine, sine and bending energy, and the binormal
-/// direction's angle and bending energies (where there is one, `has_binormal`).
+/// direction's angle and bending energies (where there is one, `has_binormal`), and the
+/// twist terms' weights.
 #[derive(Clone, Copy, Debug)]
 struct Candidates<R: Arithmetic> {
     kept_cos_sin: [R; 2],
@@ -319,6 +344,7 @@ struct Candidates<R: Arithmetic> {
     /// Where the segment has a binormal direction.
     has_binormal: R::Mask,
     binormal: Binormal<R>,
+    twist: TwistWeights<R>,
 }
 
 /// The binormal direction of a segment ([`binormal_direction_in_lanes`]) and what the sweep
@@ -343,26 +369,16 @@ impl<R: Arithmetic> Binormal<R> {
 }
 
 impl<R: Arithmetic> Candidates<R> {
-    /// No segment's.
-    #[inline(always)]
-    fn none() -> Self {
-        Candidates {
-            kept_cos_sin: [R::ONE, R::ZERO],
-            kept_bending: R::ZERO,
-            has_binormal: R::mask(false),
-            binormal: Binormal::NONE,
-        }
-    }
-
+    /// Segment `j`'s, with `θ = theta` as the sweep reaches it (`n` interior nodes).
     #[inline(always)]
     fn of<P: Trigonometry<R = R>, const N: usize>(
         frames: &RodFrames<P, N>,
         rest: &RodRest<N, R>,
         terms: ElasticTerms,
-        j: usize,
-        kept: R,
+        (theta, j, n): (&[R], usize, usize),
         kept_cos_sin: Option<[R; 2]>,
     ) -> Self {
+        let kept = theta[j];
         let kept_cos_sin = kept_cos_sin.unwrap_or_else(|| {
             let (s, c) = P::sin_cos(kept);
             [c, s]
@@ -383,6 +399,7 @@ impl<R: Arithmetic> Candidates<R> {
             kept_bending: local_bending(frames, rest, terms, j, kept_cos_sin).0,
             has_binormal,
             binormal,
+            twist: TwistWeights::of(rest, terms, theta, j, n),
         }
     }
 }
