@@ -58,7 +58,10 @@ pub use head::{Pose, Shake};
 pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
 pub use params::{DftlCoefficients, DftlParams, Mode, Params, WindParams};
 pub use pipeline::dftl::step_blocks;
-pub use pipeline::{step_strands, step_strands_in_lanes, step_strands_in_lanes_with};
+pub use pipeline::rod::RodScratch;
+pub use pipeline::{
+    step_strands, step_strands_in_lanes, step_strands_in_lanes_with, step_strands_with,
+};
 pub use projection::project_constraints;
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};

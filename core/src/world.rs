@@ -11,7 +11,8 @@ use crate::grab::{retarget, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{DefaultMath, Math, Vec3};
 use crate::params::{DftlCoefficients, Params};
-use crate::pipeline::{begin, finish, step_strands, Inputs, Stepping};
+use crate::pipeline::rod::RodScratch;
+use crate::pipeline::{begin, finish, step_strands_with, Inputs, Stepping};
 use crate::report::StepReport;
 use crate::strand::Strand;
 
@@ -38,6 +39,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     grabs: heapless::Vec<Grab, MAX_GRABS>,
     head: Pose,
     steps: u64,
+    /// The rod step's scratch space: built here once, never per step (not state: not hashed,
+    /// snapshotted or cloned).
+    scratch: RodScratch<M, N>,
     math: PhantomData<M>,
 }
 
@@ -59,6 +63,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             grabs: heapless::Vec::new(),
             head: Pose::IDENTITY,
             steps: 0,
+            scratch: RodScratch::new(),
             math: PhantomData,
         }
     }
@@ -206,12 +211,14 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         };
         let ctx = begin(world, &inputs, &mut report);
         let accelerations = input.accelerations;
-        step_strands::<M, N>(
+        let scratch = Some(&mut self.scratch);
+        let at = (0, &self.grabs[..]);
+        step_strands_with::<M, N>(
             &ctx,
             &mut self.strands,
-            0,
-            &self.grabs,
+            at,
             accelerations,
+            scratch,
             &mut report,
         );
         finish(&mut self.grabs, &report);

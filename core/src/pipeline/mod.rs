@@ -32,6 +32,7 @@ use crate::params::{DftlCoefficients, Params};
 use crate::projection::lanes::BlockProjection;
 use crate::report::{Flags, StepReport};
 use crate::strand::Strand;
+use rod::RodScratch;
 
 /// Steps a block of strands by one `ctx.dt` through its solver's pipeline. `first_strand` is
 /// the index of `strands[0]` in the whole scene (for grabs and the report); `accelerations`,
@@ -45,12 +46,29 @@ pub fn step_strands<M: Math, const N: usize>(
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
+    let at = (first_strand, grabs);
+    step_strands_with::<M, N>(ctx, strands, at, accelerations, None, report);
+}
+
+/// [`step_strands`] with the rod's scratch space kept by the caller (a [`crate::World`] keeps
+/// one), so that no step builds one; `None` builds one for the call if the solver is the rod.
+pub fn step_strands_with<M: Math, const N: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    (first_strand, grabs): (u32, &[Grab]),
+    accelerations: Option<&[Vec3]>,
+    scratch: Option<&mut RodScratch<M, N>>,
+    report: &mut StepReport,
+) {
     let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
     match ctx.params.solver {
         Solver::Rod => {
+            // One scratch space for all the call's strands.
+            let mut own = None;
+            let scratch = scratch.unwrap_or_else(|| own.insert(RodScratch::<M, N>::new()));
             for (k, strand) in strands.iter_mut().enumerate() {
-                let index = first_strand + k as u32;
-                rod::step_strand::<M, N>(strand, ctx, grabs, index, of_strand(k), report);
+                let at = (grabs, first_strand + k as u32);
+                rod::step_strand::<M, N>(strand, ctx, at, of_strand(k), scratch, report);
             }
         }
         Solver::Dftl => {

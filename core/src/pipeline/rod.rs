@@ -22,7 +22,7 @@ use crate::forces::External;
 use crate::grab::Grab;
 use crate::guard::{guard, sound};
 use crate::math::{unit, Math, Real, Vec3};
-use crate::projection::lanes::project_strand;
+use crate::projection::lanes::{project_strand, BlockProjection};
 use crate::projection::project_constraints;
 use crate::report::{Stage, StepReport};
 use crate::rod::energy::elastic_forces_with_angles;
@@ -49,29 +49,76 @@ use crate::strand::{Strand, StrandState};
 pub fn step_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    grabs: &[Grab],
-    index: u32,
+    (grabs, index): (&[Grab], u32),
     accelerations: Option<&[Vec3]>,
+    scratch: &mut RodScratch<M, N>,
     report: &mut StepReport,
 ) {
     // Sec. 5: the frames of the configuration the step starts from, one buffer for the step.
-    let mut frames: Option<RodFrames<M, N>> = None;
-    if ctx.gates.frames {
-        frames.insert(RodFrames::empty()).refresh(strand);
+    let mut frames = ctx.gates.frames.then_some(&mut scratch.frames);
+    if let Some(frames) = frames.as_mut() {
+        frames.refresh(strand);
     }
     let begun = begin(
         strand,
         ctx,
         grabs,
         index,
-        starting_from(frames.as_ref()),
+        starting_from(frames.as_deref()),
         report,
     );
     // Lines 3–4: forces and integration, in substeps or one linearly implicit step.
-    let angles = integrate(strand, ctx, &begun, frames.as_mut(), accelerations, report);
+    let angles = integrate(
+        strand,
+        ctx,
+        &begun,
+        frames.as_deref_mut(),
+        accelerations,
+        report,
+    );
     // Lines 5–11.
-    let frames = frames.as_mut();
-    finish(strand, ctx, grabs, index, &begun, frames, &angles, report);
+    let at = (grabs, index, &mut scratch.projection);
+    finish(strand, ctx, at, &begun, frames, &angles, report);
+}
+
+/// Scratch space for [`step_strand`]: the frames' buffer and the projection's lanes at one
+/// lane. A [`crate::World`] keeps one, built at compile time; `step_strands` makes one for
+/// all the strands of a call. Nothing in it carries from one strand or step to the next (each
+/// strand's step sets what it reads): made for each strand, its zeros and copies were 5 % of
+/// the Cortex-M4F's rod step (`firmware/profile.py`).
+pub struct RodScratch<M: Math, const N: usize> {
+    frames: RodFrames<M, N>,
+    projection: BlockProjection<N, 1>,
+}
+
+impl<M: Math, const N: usize> RodScratch<M, N> {
+    /// Before its first use.
+    #[must_use]
+    pub const fn new() -> Self {
+        RodScratch {
+            frames: RodFrames::empty(),
+            projection: BlockProjection::new(),
+        }
+    }
+}
+
+impl<M: Math, const N: usize> Default for RodScratch<M, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// A copy holds nothing of the original: its contents are never read before they are set.
+impl<M: Math, const N: usize> Clone for RodScratch<M, N> {
+    fn clone(&self) -> Self {
+        Self::new()
+    }
+}
+
+impl<M: Math, const N: usize> core::fmt::Debug for RodScratch<M, N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("RodScratch")
+    }
 }
 
 /// What a strand's step decided and kept before its forces and integration.
@@ -180,19 +227,17 @@ pub(super) fn integrate<M: Math, const N: usize>(
 
 /// Lines 5–11 of a strand's step, after its forces and integration: [`constrain`], the twist
 /// ([`twist_alone`]) and [`judge`]. `angles` are the `(cos θ^j, sin θ^j)` the forces used;
-/// `frames` a buffer for the frames.
-#[allow(clippy::too_many_arguments)] // the step's inputs, its strand, and what it began with
+/// `frames` a buffer for the frames, `projection` the projection's scratch space.
 pub(super) fn finish<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    grabs: &[Grab],
-    index: u32,
+    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1>),
     begun: &Begun<M, N>,
     frames: Option<&mut RodFrames<M, N>>,
     angles: &[[Real; 2]; N],
     report: &mut StepReport,
 ) {
-    constrain(strand, ctx, grabs, index, begun, report);
+    constrain(strand, ctx, (grabs, index, projection), begun, report);
     twist_alone(strand, ctx, begun, frames, angles, report);
     judge(strand, ctx, index, begun, report);
 }
@@ -203,14 +248,13 @@ pub(super) fn finish<M: Math, const N: usize>(
 pub(super) fn constrain<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    grabs: &[Grab],
-    index: u32,
+    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1>),
     begun: &Begun<M, N>,
     report: &mut StepReport,
 ) {
     couple_root(strand, ctx, begun, report);
     if ctx.gates.projection {
-        project_strand::<M, N>(strand, ctx, grabs, index, report);
+        project_strand::<M, N>(strand, ctx, (grabs, index), projection, report);
     }
 }
 

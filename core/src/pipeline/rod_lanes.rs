@@ -262,6 +262,8 @@ fn project<M: Math, const N: usize, const W: usize>(
         begun[lane].is_some() && strands.get(lane).is_some_and(fits)
     });
     let in_lanes = taken.iter().filter(|&&t| t).count() > 1 && lanes.run::<M>(strands, &taken, ctx);
+    // The scratch space of the strands projected alone, made once if any is.
+    let mut alone: Option<BlockProjection<N, 1>> = None;
     for (lane, strand) in strands.iter_mut().enumerate().take(W) {
         if begun[lane].is_none() {
             continue;
@@ -269,11 +271,14 @@ fn project<M: Math, const N: usize, const W: usize>(
         // A strand `taken` fits the lanes' kernel: no second `fits_lanes` for it.
         if in_lanes && taken[lane] {
             lanes.finish::<M>(lane, strand, ctx, report);
-        } else if taken[lane] {
-            project_alone::<M, N>(strand, ctx, report);
+            continue;
+        }
+        let scratch = alone.get_or_insert_with(BlockProjection::default);
+        if taken[lane] {
+            project_alone::<M, N>(strand, ctx, scratch, report);
         } else {
-            let index = first_strand + lane as u32;
-            project_strand::<M, N>(strand, ctx, grabs, index, report);
+            let at = (grabs, first_strand + lane as u32);
+            project_strand::<M, N>(strand, ctx, at, scratch, report);
         }
     }
 }

@@ -67,6 +67,16 @@ pub struct Row {
 }
 
 impl Row {
+    /// [`Row::default`], as a constant.
+    pub const EMPTY: Row = Row {
+        value: 0.0,
+        rhs: 0.0,
+        nodes: [0; 2],
+        gradient: Vec3::ZERO,
+        projected: [Vec3::ZERO; 2],
+        kind: RowKind::Padding,
+    };
+
     /// Inextensibility of segment `j` (nodes `j`, `j + 1`): `C = e·e − ê·ê`.
     #[must_use]
     pub fn segment(j: usize, x_j: Vec3, x_next: Vec3, rest_length: Real) -> Row {
@@ -148,6 +158,18 @@ pub struct NodeContacts {
 }
 
 impl NodeContacts {
+    /// [`NodeContacts::default`], as a constant.
+    pub const EMPTY: NodeContacts = NodeContacts {
+        count: 0,
+        collider: [0; MAX_NODE_CONTACTS],
+        value: [0.0; MAX_NODE_CONTACTS],
+        gradient: [Vec3::ZERO; MAX_NODE_CONTACTS],
+        kept: 0,
+        inverse_gram: [0.0; 3],
+        displacement: Vec3::ZERO,
+        tentative: 0,
+    };
+
     fn push(&mut self, collider: u8, value: Real, gradient: Vec3, tentative: bool) -> bool {
         let mut k = usize::from(self.count);
         if k >= MAX_NODE_CONTACTS && !tentative && self.tentative != 0 {
@@ -301,12 +323,21 @@ impl<const N: usize> Default for Rows<N> {
     // workspace), not built on the stack and copied there.
     #[inline(always)]
     fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Rows<N> {
+    /// No rows (`const`: a world's scratch space is built at compile time).
+    #[inline(always)]
+    #[must_use]
+    pub const fn new() -> Self {
         Rows {
-            rows: [Row::default(); N],
+            rows: [Row::EMPTY; N],
             first: [0; N],
             count: 0,
             segment_row: [NO_ROW; N],
-            contacts: [NodeContacts::default(); N],
+            contacts: [NodeContacts::EMPTY; N],
             contact_nodes: [0; N],
             contact_count: 0,
             residual: 0.0,
@@ -399,6 +430,15 @@ impl<const N: usize> ContactMemory<N> {
 impl<const N: usize> Default for ContactMemory<N> {
     #[inline(always)]
     fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> ContactMemory<N> {
+    /// Nothing remembered (`const`, as [`Rows::new`]).
+    #[inline(always)]
+    #[must_use]
+    pub const fn new() -> Self {
         ContactMemory {
             touched: [0; N],
             multipliers: [[0.0; MAX_COLLIDERS]; N],

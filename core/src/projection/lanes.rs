@@ -59,34 +59,36 @@ pub fn fits_lanes<const N: usize>(
 /// a strand laid out as most are ([`fits_lanes`]: no grab, every node past the root's two
 /// free) through the lanes' kernel at one lane, which knows its rows' layout in advance; any
 /// other through the general projection, which lays its rows out each iteration. What the
-/// rod's step calls for one strand.
+/// rod's step calls for one strand; `scratch` is the lanes' space ([`project_alone`]).
 pub fn project_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    grabs: &[Grab],
-    strand_index: u32,
+    (grabs, strand_index): (&[Grab], u32),
+    scratch: &mut BlockProjection<N, 1>,
     report: &mut StepReport,
 ) -> Outcome {
     let nodes = strand.rest.nodes.min(N);
     if fits_lanes(strand, ctx, grabs, strand_index, nodes) {
-        project_alone::<M, N>(strand, ctx, report)
+        project_alone::<M, N>(strand, ctx, scratch, report)
     } else {
         project_constraints::<M, N>(strand, ctx, grabs, strand_index, report)
     }
 }
 
 /// [`super::project_constraints`] of one strand that [`fits_lanes`], by the lanes' kernel at
-/// one lane: no row map, no grab, no padding row. Not inlined, so that its scratch space and
-/// the general projection's are not both on the stack.
+/// one lane: no row map, no grab, no padding row. `scratch` is the lanes' space, made once for
+/// many strands: nothing in it carries from one strand to the next (`BlockProjection::run`
+/// sets what it reads), and made for each strand, its zeros were 4 % of the Cortex-M4F's rod
+/// step (`firmware/profile.py`).
 #[inline(never)]
 pub(crate) fn project_alone<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
+    scratch: &mut BlockProjection<N, 1>,
     report: &mut StepReport,
 ) -> Outcome {
-    let mut lane = BlockProjection::<N, 1>::default();
-    lane.run::<M>(core::slice::from_ref(strand), &[true], ctx);
-    lane.finish::<M>(0, strand, ctx, report)
+    scratch.run::<M>(core::slice::from_ref(strand), &[true], ctx);
+    scratch.finish::<M>(0, strand, ctx, report)
 }
 
 /// One lane's bookkeeping: what [`super::project_constraints`] keeps for its strand besides
@@ -131,35 +133,60 @@ pub struct BlockProjection<const N: usize, const W: usize> {
 
 impl<const N: usize, const W: usize> Default for BlockProjection<N, W> {
     fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Lane<N> {
+    /// A lane before its first use.
+    const EMPTY: Self = Lane {
+        nodes: Nodes {
+            inverse_mass: [0.0; N],
+            count: 0,
+        },
+        rows: Rows::new(),
+        contacts: ContactMemory::new(),
+        collider_push: [Vec3::ZERO; MAX_COLLIDERS],
+        near: NearColliders::none(),
+        outcome: Outcome {
+            iterations: 0,
+            residual: 0.0,
+            converged: false,
+            dropped_rows: 0,
+            collision_rows: 0,
+        },
+        truncated: false,
+        trust_radius: 0.0,
+        running: false,
+    };
+}
+
+impl<const N: usize, const W: usize> BlockProjection<N, W> {
+    /// A scratch space before its first use (`const`: a world keeps one, built at compile
+    /// time, so that no step fills one).
+    #[must_use]
+    pub const fn new() -> Self {
         let zero = Wide([0.0; W]);
+        let zero3 = V3 {
+            x: zero,
+            y: zero,
+            z: zero,
+        };
         BlockProjection {
             taken: [false; W],
             nodes: 0,
-            position: [V3::zero(); N],
+            position: [zero3; N],
             inverse_mass: [zero; N],
             rest_squared: [zero; N],
             value: [zero; N],
             rhs: [zero; N],
-            gradient: [V3::zero(); N],
-            projected: [[V3::zero(); 2]; N],
+            gradient: [zero3; N],
+            projected: [[zero3; 2]; N],
             multipliers: [zero; N],
             lower: [zero; N],
             fresh: [zero; N],
-            step: [V3::zero(); N],
-            lanes: core::array::from_fn(|_| Lane {
-                nodes: Nodes {
-                    inverse_mass: [0.0; N],
-                    count: 0,
-                },
-                rows: Rows::default(),
-                contacts: ContactMemory::default(),
-                collider_push: [Vec3::ZERO; MAX_COLLIDERS],
-                near: NearColliders::none(),
-                outcome: Outcome::default(),
-                truncated: false,
-                trust_radius: 0.0,
-                running: false,
-            }),
+            step: [zero3; N],
+            lanes: [const { Lane::EMPTY }; W],
         }
     }
 }

@@ -444,7 +444,7 @@ impl NearColliders {
     }
 
     /// No collider near: for a scratch space before its first use.
-    pub(crate) fn none() -> Self {
+    pub(crate) const fn none() -> Self {
         let placeholder = Shape::Plane {
             point: Vec3::ZERO,
             normal: Vec3::Y,

@@ -629,7 +629,8 @@ fn collision_rows_count_each_row_once_per_solved_iterate() {
             let outcome = if kernel == 0 {
                 project_constraints::<Libm, N>(&mut strand, &ctx, &[], 0, &mut report)
             } else {
-                lanes::project_alone::<Libm, N>(&mut strand, &ctx, &mut report)
+                let mut scratch = lanes::BlockProjection::default();
+                lanes::project_alone::<Libm, N>(&mut strand, &ctx, &mut scratch, &mut report)
             };
             assert_eq!(outcome.collision_rows, report.collision_rows);
             rows[k] = report.collision_rows;
@@ -707,8 +708,15 @@ fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
                     assert!(lanes::fits_lanes(&strand, &ctx, &[], 0, 20));
                     let mut general = strand.clone();
                     let (mut a, mut b) = (StepReport::default(), StepReport::default());
-                    let outcome =
-                        lanes::project_strand::<Libm, N>(&mut strand, &ctx, &[], 0, &mut a);
+                    let mut scratch = lanes::BlockProjection::default();
+                    let at = (&[][..], 0);
+                    let outcome = lanes::project_strand::<Libm, N>(
+                        &mut strand,
+                        &ctx,
+                        at,
+                        &mut scratch,
+                        &mut a,
+                    );
                     let other = project_constraints::<Libm, N>(&mut general, &ctx, &[], 0, &mut b);
                     let case = std::format!("{mode:?} {effects:?} cap {cap} k {k}");
                     assert_eq!(

@@ -77,7 +77,7 @@ impl<P: Kernel, const N: usize> RodFrames<P, N> {
     /// Frames of no polyline: every entry at the value [`Self::compute`] leaves where it
     /// writes nothing (no binormal at the root or the tip, denominator 1).
     #[must_use]
-    pub fn empty() -> Self {
+    pub const fn empty() -> Self {
         let zero = <P::V as Vector<P::R>>::ZERO;
         RodFrames {
             nodes: 0,
