@@ -28,7 +28,7 @@
 /** Node capacity per strand (HAIRSIM_NODES when the library was built). */
 #define HAIRSIM_NODES 16
 /** Bytes of a world buffer: measured on a 64-bit host, no fewer than a 32-bit target needs. */
-#define HAIRSIM_WORLD_SIZE 8560
+#define HAIRSIM_WORLD_SIZE 14576
 /** Alignment of a world buffer, bytes. */
 #define HAIRSIM_WORLD_ALIGN 8
 /** Declares a world buffer of the right size and alignment: `static HAIRSIM_WORLD_STORAGE(w);` */
