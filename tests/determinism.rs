@@ -58,14 +58,15 @@ mod rod_blocks {
     const STEPS: u32 = 1500;
 
     /// What the blocks met: steps of a block whose lanes all took the same substeps (the
-    /// lanes' path), differed in substep count, mixed the implicit step with substeps, or
-    /// differed in projection iterations; roll-backs; steps with a node held by a grab, and
-    /// with nodes in contact with the head.
+    /// lanes' path), differed in substep count, mixed the implicit step with substeps, had
+    /// two strands or more take the implicit step, or differed in projection iterations;
+    /// roll-backs; steps with a node held by a grab, and with nodes in contact with the head.
     #[derive(Debug, Default)]
     struct Cases {
         same_substeps: u32,
         different_substeps: u32,
         implicit_beside_explicit: u32,
+        implicit_together: u32,
         different_iterations: u32,
         roll_backs: u32,
         grabbed: u32,
@@ -90,8 +91,9 @@ mod rod_blocks {
             })
             .collect();
         let mut material = Material::HUMAN_HAIR;
-        if s == 5 {
-            // Ten times stiffer: 12 fixed substeps, so the implicit step from the first.
+        if s == 5 || s == 6 {
+            // Ten times stiffer: 12 fixed substeps, so the implicit step from the first. At 4
+            // and at 8 lanes, both take it in the same block, beside explicit lanes.
             material.youngs_modulus *= 10.0;
         }
         Strand::from_polyline(&points, &material).unwrap()
@@ -216,6 +218,7 @@ mod rod_blocks {
                 cases.different_substeps += u32::from(explicit_differ);
                 cases.implicit_beside_explicit +=
                     u32::from(!substeps.is_empty() && substeps.len() < block.len());
+                cases.implicit_together += u32::from(block.len() - substeps.len() > 1);
                 cases.different_iterations += u32::from(its.iter().any(|&i| i != its[0]));
             }
         }
@@ -233,6 +236,7 @@ mod rod_blocks {
         ] {
             assert!(cases.same_substeps > 0, "{cases:?}");
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+            assert!(cases.implicit_together > 0, "{cases:?}");
             assert!(cases.grabbed > 0, "{cases:?}");
             assert!(cases.contacts > 0, "{cases:?}");
         }
@@ -243,6 +247,7 @@ mod rod_blocks {
             assert!(cases.same_substeps > 0, "{cases:?}");
             assert!(cases.different_substeps > 0, "{cases:?}");
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+            assert!(cases.implicit_together > 0, "{cases:?}");
             assert!(cases.different_iterations > 0, "{cases:?}");
             assert!(cases.roll_backs > 0, "{cases:?}");
             assert!(cases.grabbed > 0, "{cases:?}");
@@ -258,6 +263,7 @@ mod rod_blocks {
         let cases = check::<Libm, 4>(Mode::FixedCost, TwistMethod::Newton);
         assert!(cases.same_substeps > 0, "{cases:?}");
         assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+        assert!(cases.implicit_together > 0, "{cases:?}");
         assert!(cases.grabbed > 0 && cases.contacts > 0, "{cases:?}");
         for cases in [
             check::<Libm, 4>(Mode::Converge, TwistMethod::Newton),
@@ -265,6 +271,7 @@ mod rod_blocks {
         ] {
             assert!(cases.different_substeps > 0, "{cases:?}");
             assert!(cases.implicit_beside_explicit > 0, "{cases:?}");
+            assert!(cases.implicit_together > 0, "{cases:?}");
             assert!(cases.different_iterations > 0, "{cases:?}");
             assert!(cases.roll_backs > 0, "{cases:?}");
             assert!(cases.grabbed > 0 && cases.contacts > 0, "{cases:?}");

@@ -441,6 +441,14 @@ impl<const W: usize> Vector<Wide<W>> for V3<Wide<W>> {
         z: Wide::ZERO,
     };
     #[inline(always)]
+    fn components(self) -> [Wide<W>; 3] {
+        [self.x, self.y, self.z]
+    }
+    #[inline(always)]
+    fn from_components([x, y, z]: [Wide<W>; 3]) -> Self {
+        V3 { x, y, z }
+    }
+    #[inline(always)]
     fn dot(self, other: Self) -> Wide<W> {
         V3::dot(self, other)
     }

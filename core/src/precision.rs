@@ -259,10 +259,22 @@ pub trait Vector<R: Arithmetic>:
     fn cross(self, other: Self) -> Self;
     /// Per lane `if mask { a } else { b }`.
     fn select(mask: R::Mask, a: Self, b: Self) -> Self;
+    /// `[x, y, z]`.
+    fn components(self) -> [R; 3];
+    /// The vector `[x, y, z]`.
+    fn from_components(c: [R; 3]) -> Self;
 }
 
 impl Vector<f32> for Vec3 {
     const ZERO: Self = Vec3::ZERO;
+    #[inline(always)]
+    fn components(self) -> [f32; 3] {
+        self.to_array()
+    }
+    #[inline(always)]
+    fn from_components(c: [f32; 3]) -> Self {
+        Vec3::from_array(c)
+    }
     #[inline(always)]
     fn dot(self, other: Self) -> f32 {
         Vec3::dot(self, other)
@@ -283,6 +295,14 @@ impl Vector<f32> for Vec3 {
 
 impl Vector<f64> for DVec3 {
     const ZERO: Self = DVec3::ZERO;
+    #[inline(always)]
+    fn components(self) -> [f64; 3] {
+        self.to_array()
+    }
+    #[inline(always)]
+    fn from_components(c: [f64; 3]) -> Self {
+        DVec3::from_array(c)
+    }
     #[inline(always)]
     fn dot(self, other: Self) -> f64 {
         DVec3::dot(self, other)

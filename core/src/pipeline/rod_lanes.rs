@@ -6,10 +6,11 @@
 //! stages run strand by strand: the snapshot and plan, root coupling, the guard.
 //!
 //! Strands that differ in their substep count are masked once they have taken theirs, and
-//! strands that differ in their projection iterations once they have converged. A strand that
-//! takes the implicit step, projects between substeps, or has another node count than the
-//! block's steps alone; so does the twist and the projection of a strand holding a grabbed
-//! node, and the Newton twist.
+//! strands that differ in their projection iterations once they have converged; the strands
+//! that take the linearly implicit step (`rod::implicit`) take it in lanes too, the others
+//! masked. A strand that projects between substeps, or has another node count than the
+//! block's, steps alone; so does the twist and the projection of a strand holding a grabbed
+//! node.
 
 use crate::context::StepContext;
 use crate::forces::{drag, External};
@@ -21,6 +22,7 @@ use crate::report::{Stage, StepReport};
 use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
 use crate::rod::frames::RodFrames;
+use crate::rod::implicit::{step_nodes, Loads};
 use crate::rod::integrate::{starting_at, symplectic_euler, Nodes};
 use crate::rod::substeps::{
     inextensibility_between_substeps, smallest_binormal_denominator_in_lane, Integration,
@@ -30,6 +32,7 @@ use crate::rod::twist::{
     TwistMethod,
 };
 use crate::rod::{ClampedSegments, ElasticTerms};
+use crate::root_coupling::held_velocity;
 use crate::strand::Strand;
 
 use super::rod::{
@@ -72,8 +75,10 @@ struct BlockStep<M: Math, const N: usize, const W: usize> {
     frames: Option<RodFrames<M, N>>,
     /// Each strand's start.
     begun: [Option<Begun<M, N>>; W],
-    /// The substeps each lane takes in the block (0: the strand steps alone).
+    /// The substeps each lane takes in the block (0: none there).
     substeps: [u32; W],
+    /// The lanes that take the implicit step in the block.
+    implicit: [bool; W],
     /// `(cos θ^j, sin θ^j)` each strand's forces used.
     angles: [[[Real; 2]; N]; W],
 }
@@ -99,6 +104,7 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
             frames: ctx.gates.frames.then(RodFrames::empty),
             begun: [const { None }; W],
             substeps: [0; W],
+            implicit: [false; W],
             angles: [[[1.0, 0.0]; N]; W],
         }
     }
@@ -150,9 +156,17 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         if self.substeps.iter().filter(|&&k| k > 0).count() < 2 {
             self.substeps = [0; W];
         }
+        // The implicit step runs in lanes whenever the block has lanes, even for one strand:
+        // the lanes that switch to it and those that do not are masked, none steps alone.
+        self.implicit = core::array::from_fn(|lane| {
+            let implicit = |b: &Begun<M, N>| b.integration == Integration::Implicit;
+            let started = self.begun[lane].as_ref().is_some_and(implicit);
+            self.block.is_some() && self.gathered[lane] && started
+        });
     }
 
-    /// Lines 3–4: the lanes' substeps, then each strand that steps alone.
+    /// Lines 3–4: the lanes' implicit step, then their substeps (which recompute the frames
+    /// the implicit step reads), then each strand that steps alone.
     fn integrate(
         &mut self,
         strands: &mut [Strand<N>],
@@ -160,18 +174,23 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         accelerations: Option<&[Vec3]>,
         report: &mut StepReport,
     ) {
+        let clamped = self
+            .begun
+            .each_ref()
+            .map(|b| b.as_ref().map_or_else(Default::default, |b| b.clamped));
+        if let (Some(block), true) = (self.block.as_mut(), self.implicit.contains(&true)) {
+            let (frames, implicit) = (&self.lane_frames, &self.implicit);
+            implicit_in_lanes(block, frames, (strands, implicit), ctx, &clamped, report);
+            block.scatter(strands, implicit, &mut self.angles);
+        }
         if let (Some(block), true) = (self.block.as_mut(), self.substeps.iter().any(|&k| k > 0)) {
-            let clamped = self
-                .begun
-                .each_ref()
-                .map(|b| b.as_ref().map_or_else(Default::default, |b| b.clamped));
             let (frames, substeps) = (&mut self.lane_frames, &self.substeps);
             explicit_substeps_in_lanes(block, frames, ctx, &clamped, substeps, report);
-            block.scatter(strands, substeps, &mut self.angles);
+            block.scatter(strands, &substeps.map(|k| k > 0), &mut self.angles);
         }
         let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
-            let alone = self.substeps[lane] == 0;
+            let alone = self.substeps[lane] == 0 && !self.implicit[lane];
             let Some(begun) = self.begun[lane].as_ref().filter(|_| alone) else {
                 continue;
             };
@@ -325,6 +344,63 @@ fn twist_in_lanes<M: Math, const N: usize, const W: usize>(
         }
     }
     block.take_angles(strands, in_lanes);
+}
+
+/// `super::rod::implicit_bending` of the lanes `implicit` names (`strands` are the block's):
+/// the elastic forces at the frames the step starts from, the held nodes' velocities strand
+/// by strand, then `rod::implicit::step_nodes` in lanes, the other lanes masked. The same
+/// kernels on each lane's values, so each strand gets the bits it gets alone.
+#[inline(never)]
+fn implicit_in_lanes<M: Math, const N: usize, const W: usize>(
+    block: &mut LaneBlock<N, W>,
+    frames: &RodFrames<Lanes<M, W>, N>,
+    (strands, implicit): (&[Strand<N>], &[bool; W]),
+    ctx: &StepContext,
+    clamped: &[ClampedSegments; W],
+    report: &mut StepReport,
+) {
+    let lanes = implicit.iter().filter(|&&i| i).count() as u32;
+    report.ran_on(Stage::ElasticForces, lanes);
+    report.ran_on(Stage::ExternalForces, lanes);
+    report.ran_on(Stage::Integrate, lanes);
+    let terms = ElasticTerms::of(&ctx.gates);
+    let mut forces = [V3::<Wide<W>>::zero(); N];
+    let (theta, rest, cos_sin) = (&block.theta, &block.rest, &block.cos_sin);
+    elastic_forces_with_angles(frames, theta, cos_sin, rest, clamped, terms, &mut forces);
+    // The masses and the head's motion of nodes 0 and 1 of the lanes that take the step (the
+    // others, masked, keep 1 and 0: finite values).
+    let mut mass = [Wide::splat(1.0); N];
+    let mut held = [V3::<Wide<W>>::zero(); 2];
+    let nodes = block.nodes;
+    for (lane, strand) in strands.iter().enumerate().take(W) {
+        if implicit[lane] {
+            for (slot, m) in mass.iter_mut().zip(&strand.rest.mass).take(nodes) {
+                slot.0[lane] = *m;
+            }
+            for (i, slot) in held.iter_mut().enumerate() {
+                slot.set_lane(lane, held_velocity(ctx, strand, i));
+            }
+        }
+    }
+    let external = External::<Lanes<M, W>> {
+        gravity_and_wind: V3::splat(ctx.gravity + ctx.wind),
+        drag: Wide::splat(drag(ctx)),
+    };
+    let lane_nodes = Nodes::<Lanes<M, W>, N> {
+        count: nodes,
+        position: &mut block.position,
+        velocity: &mut block.velocity,
+        inverse_mass: &block.inverse_mass,
+    };
+    let loads = Loads {
+        mass: &mass,
+        rest: &block.rest,
+        forces: &forces,
+        external: &external,
+        accelerations: block.accelerations.as_ref().map(|a| &a[..]),
+    };
+    let h = Wide::splat(ctx.dt);
+    step_nodes(lane_nodes, &loads, frames, (h, held), WideMask(*implicit));
 }
 
 /// Whether `k` substeps run without a projection between them (what the lanes do).

@@ -155,17 +155,18 @@ impl<const N: usize, const W: usize> LaneBlock<N, W> {
         r.stable_time_step.0[lane] = rod.stable_time_step;
     }
 
-    /// Writes the free nodes' positions and velocities of the lanes that took substeps
-    /// (`substeps[l] > 0`) back into `strands`, and their `(cos θ^j, sin θ^j)` into `angles`.
+    /// Writes the free nodes' positions and velocities of the lanes `moved` names (those that
+    /// took their substeps or their implicit step in lanes) back into `strands`, and their
+    /// `(cos θ^j, sin θ^j)` into `angles`.
     pub fn scatter(
         &self,
         strands: &mut [Strand<N>],
-        substeps: &[u32; W],
+        moved: &[bool; W],
         angles: &mut [[[Real; 2]; N]; W],
     ) {
         let lanes = strands.iter_mut().zip(angles.iter_mut()).enumerate();
         for (lane, (strand, angles)) in lanes.take(W) {
-            if substeps[lane] == 0 {
+            if !moved[lane] {
                 continue;
             }
             for i in 2..self.nodes.min(N) {

@@ -38,9 +38,11 @@
 //! solved in O(n), in storage sized by `N`.
 
 use super::frames::RodFrames;
+use super::integrate::Nodes;
 use crate::context::StepContext;
 use crate::forces::External;
 use crate::math::{Math, Real, Vec3};
+use crate::precision::{Arithmetic, Kernel, Vector};
 use crate::strand::{RodRest, Strand};
 
 /// Half-bandwidth of `M + h² H̃` in scalar unknowns: node `i`'s row reaches node `i − 2`'s
@@ -48,25 +50,28 @@ use crate::strand::{RodRest, Strand};
 pub const BAND: usize = 8;
 
 /// One scalar row of the band: `[A(r, r), A(r, r − 1), …, A(r, r − BAND)]`.
-type BandRow = [Real; BAND + 1];
+type BandRow<R> = [R; BAND + 1];
 
-/// `M + h² H̃` for one strand (lower band, rows node-major then axis), factored in place.
+/// `M + h² H̃` for one strand, or for `W` strands in lanes (lower band, rows node-major then
+/// axis), factored in place. Written over a [`Kernel`], as the explicit substeps are, so a
+/// strand in a block's lane gets the bits it gets alone.
 #[derive(Clone, Debug)]
-pub struct BendingSystem<const N: usize> {
-    band: [[BandRow; 3]; N],
-    inverse_pivot: [[Real; 3]; N],
+pub struct BendingSystem<P: Kernel, const N: usize> {
+    band: [[BandRow<P::R>; 3]; N],
+    inverse_pivot: [[P::R; 3]; N],
     nodes: usize,
     /// Smallest pivot [`Self::factor`] accepts: half the lightest unknown node's mass.
-    pivot_floor: Real,
+    pivot_floor: P::R,
 }
 
-impl<const N: usize> Default for BendingSystem<N> {
+impl<P: Kernel, const N: usize> Default for BendingSystem<P, N> {
     fn default() -> Self {
+        let zero = P::R::ZERO;
         BendingSystem {
-            band: [[[0.0; BAND + 1]; 3]; N],
-            inverse_pivot: [[0.0; 3]; N],
+            band: [[[zero; BAND + 1]; 3]; N],
+            inverse_pivot: [[zero; 3]; N],
             nodes: 0,
-            pivot_floor: 0.0,
+            pivot_floor: zero,
         }
     }
 }
@@ -79,13 +84,22 @@ pub const PIVOT_RESOLUTION: Real = 1.0 / 1_048_576.0;
 /// First unknown row: nodes 0 and 1 are held by the head.
 const FIRST_ROW: usize = 6;
 
+/// The larger of `a` and `b` (`b` where `a < b`): `f32::max` for the finite stiffnesses it
+/// compares, as a select, so that it runs in lanes.
+#[inline(always)]
+fn larger<R: Arithmetic>(a: R, b: R) -> R {
+    R::select(a.lt(b), b, a)
+}
+
 /// `e × x̂`, `e × ŷ`, `e × ẑ`: the columns of `v ↦ e × v`.
 #[inline(always)]
-fn cross_columns(e: Vec3) -> [Vec3; 3] {
+fn cross_columns<P: Kernel>(e: P::V) -> [P::V; 3] {
+    let [x, y, z] = e.components();
+    let zero = P::R::ZERO;
     [
-        Vec3::new(0.0, e.z, -e.y),
-        Vec3::new(-e.z, 0.0, e.x),
-        Vec3::new(e.y, -e.x, 0.0),
+        P::V::from_components([zero, z, -y]),
+        P::V::from_components([-z, zero, x]),
+        P::V::from_components([y, -x, zero]),
     ]
 }
 
@@ -93,13 +107,18 @@ fn cross_columns(e: Vec3) -> [Vec3; 3] {
 /// `d = |ê^{i−1}||ê^i| + e^{i−1}·e^i`: `A = (−2[e^i]× − κb e^{iᵀ}) / d`,
 /// `C = (2[e^{i−1}]× − κb e^{i−1ᵀ}) / d` with `[e]× v = e × v`, column `b` of each, given `1/d`.
 #[inline(always)]
-fn binormal_jacobians(e_prev: Vec3, e_next: Vec3, kb: Vec3, inv_d: Real) -> ([Vec3; 3], [Vec3; 3]) {
-    let two_inv_d = 2.0 * inv_d;
+fn binormal_jacobians<P: Kernel>(
+    e_prev: P::V,
+    e_next: P::V,
+    kb: P::V,
+    inv_d: P::R,
+) -> ([P::V; 3], [P::V; 3]) {
+    let two_inv_d = P::R::of(2.0) * inv_d;
     let kb_d = kb * inv_d;
-    let n = cross_columns(e_next);
-    let p = cross_columns(e_prev);
-    let en = [e_next.x, e_next.y, e_next.z];
-    let ep = [e_prev.x, e_prev.y, e_prev.z];
+    let n = cross_columns::<P>(e_next);
+    let p = cross_columns::<P>(e_prev);
+    let en = e_next.components();
+    let ep = e_prev.components();
     let a = [
         -(n[0] * two_inv_d) - kb_d * en[0],
         -(n[1] * two_inv_d) - kb_d * en[1],
@@ -115,8 +134,8 @@ fn binormal_jacobians(e_prev: Vec3, e_next: Vec3, kb: Vec3, inv_d: Real) -> ([Ve
 
 /// `XᵀY` for matrices given by columns: `[p][q] = x_p · y_q`.
 #[inline(always)]
-fn gram(x: &[Vec3; 3], y: &[Vec3; 3]) -> [[Real; 3]; 3] {
-    let mut g = [[0.0; 3]; 3];
+fn gram<P: Kernel>(x: &[P::V; 3], y: &[P::V; 3]) -> [[P::R; 3]; 3] {
+    let mut g = [[P::R::ZERO; 3]; 3];
     for (row, xp) in g.iter_mut().zip(x) {
         for (slot, yq) in row.iter_mut().zip(y) {
             *slot = xp.dot(*yq);
@@ -128,17 +147,17 @@ fn gram(x: &[Vec3; 3], y: &[Vec3; 3]) -> [[Real; 3]; 3] {
 /// `h² · 2 b_i / l̂_i`: the weight of node `i`'s term, both frames' bending terms bounded by
 /// `b_i = max(1, µ) max(α^{i−1}, α^i)`.
 #[inline(always)]
-fn node_weight<const N: usize>(rest: &RodRest<N>, i: usize, h: Real) -> Real {
-    let penalty = rest.minor_axis_penalty.max(1.0);
-    let alpha = rest.bending_stiffness[i - 1].max(rest.bending_stiffness[i]);
-    h * h * 2.0 * penalty * alpha * rest.inverse_voronoi_length[i]
+fn node_weight<R: Arithmetic, const N: usize>(rest: &RodRest<N, R>, i: usize, h: R) -> R {
+    let penalty = larger(rest.minor_axis_penalty, R::ONE);
+    let alpha = larger(rest.bending_stiffness[i - 1], rest.bending_stiffness[i]);
+    h * h * R::of(2.0) * penalty * alpha * rest.inverse_voronoi_length[i]
 }
 
 /// `J_i = ∂(κb)_i/∂(x_{i−1}, x_i, x_{i+1}) = (−A, A − C, C)` from `frames`
 /// ([`binormal_jacobians`]), by columns per node.
 #[inline(always)]
-fn node_jacobian<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize) -> [[Vec3; 3]; 3] {
-    let (a, c) = binormal_jacobians(
+fn node_jacobian<P: Kernel, const N: usize>(frames: &RodFrames<P, N>, i: usize) -> [[P::V; 3]; 3] {
+    let (a, c) = binormal_jacobians::<P>(
         frames.edge[i - 1],
         frames.edge[i],
         frames.curvature_binormal[i],
@@ -183,11 +202,11 @@ pub const HOLONOMY_SHARE: Real = 0.5;
 /// `∇ψ_i` on `(x_{i−1}, x_i, x_{i+1})`, the holonomy gradient of the force code:
 /// `(κ̃b/(2|e^{i−1}|), −(first + last), −κ̃b/(2|e^i|))`, `κ̃b = 2 t^{i−1}×t^i/(1 + t^{i−1}·t^i)`.
 #[inline(always)]
-fn holonomy_gradient<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize) -> [Vec3; 3] {
+fn holonomy_gradient<P: Kernel, const N: usize>(frames: &RodFrames<P, N>, i: usize) -> [P::V; 3] {
     let (t_prev, t_next) = (frames.tangent[i - 1], frames.tangent[i]);
-    let kb_unit = t_prev.cross(t_next) * (2.0 / (1.0 + t_prev.dot(t_next)));
-    let first = kb_unit * (0.5 * frames.inverse_length[i - 1]);
-    let last = -(kb_unit * (0.5 * frames.inverse_length[i]));
+    let kb_unit = t_prev.cross(t_next) * (P::R::of(2.0) / (P::R::ONE + t_prev.dot(t_next)));
+    let first = kb_unit * (P::R::of(0.5) * frames.inverse_length[i - 1]);
+    let last = -(kb_unit * (P::R::of(0.5) * frames.inverse_length[i]));
     [first, -(first + last), last]
 }
 
@@ -204,13 +223,14 @@ fn holonomy_gradient<M: Math, const N: usize>(frames: &RodFrames<M, N>, i: usize
 /// (Gershgorin: `diag(Σ_l S_kl) − S` is diagonally dominant): `D_k = k C_k + Σ_{l>k} C_l`,
 /// which keeps the band. The cross terms between `J` and this part are bounded by taking
 /// both at full weight (`(a + b)² ≤ 2a² + 2b²`, and the stability bound allows a factor 2).
-fn holonomy_weights<M: Math, const N: usize>(
-    frames: &RodFrames<M, N>,
-    rest: &RodRest<N>,
-    h: Real,
-) -> [Real; N] {
+fn holonomy_weights<P: Kernel, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest: &RodRest<N, P::R>,
+    h: P::R,
+) -> [P::R; N] {
+    let zero = P::R::ZERO;
     let n = frames.interior().min(N.saturating_sub(2));
-    let mut q = [0.0; N];
+    let mut q = [zero; N];
     for (i, (slot, kb)) in q
         .iter_mut()
         .zip(&frames.curvature_binormal)
@@ -218,16 +238,17 @@ fn holonomy_weights<M: Math, const N: usize>(
         .take(n + 1)
         .skip(1)
     {
-        *slot = node_weight(rest, i, 1.0) * 0.5 * kb.dot(*kb);
+        *slot = node_weight(rest, i, P::R::ONE) * P::R::of(0.5) * kb.dot(*kb);
     }
-    let mut weights = [0.0; N];
+    let mut weights = [zero; N];
     // Frames j = 1 … n; c_j = q_j + q_{j+1}; C_k and Σ_{l>k} C_l from the tip.
-    let mut suffix = 0.0;
-    let mut beyond = 0.0;
+    let mut suffix = zero;
+    let mut beyond = zero;
+    let share = P::R::of(HOLONOMY_SHARE);
     for k in (1..=n).rev() {
-        let next = if k < n { q[k + 1] } else { 0.0 };
+        let next = if k < n { q[k + 1] } else { zero };
         suffix += q[k] + next;
-        weights[k] = HOLONOMY_SHARE * h * h * (k as Real * suffix + beyond);
+        weights[k] = share * h * h * (P::R::of(k as Real) * suffix + beyond);
         beyond += suffix;
     }
     weights
@@ -238,34 +259,33 @@ fn holonomy_weights<M: Math, const N: usize>(
 /// `s J_aᵀJ_b`, holonomy `d ∇_aψ_i ∇_bψ_iᵀ`, and the axial term of segment `i` (nodes `i`,
 /// `i + 1`). `block[p][q]` is row axis `p`, column axis `q`.
 #[inline(always)]
-fn node_blocks<M: Math, const N: usize>(
-    frames: &RodFrames<M, N>,
-    mass: &[Real; N],
-    rest: &RodRest<N>,
+fn node_blocks<P: Kernel, const N: usize>(
+    frames: &RodFrames<P, N>,
+    (mass, rest): (&[P::R; N], &RodRest<N, P::R>),
     i: usize,
-    h: Real,
-    holonomy: Real,
-) -> [[[Real; 3]; 3]; 6] {
+    h: P::R,
+    holonomy: P::R,
+) -> [[[P::R; 3]; 3]; 6] {
     let s = node_weight(rest, i, h);
-    let (a, c) = binormal_jacobians(
+    let (a, c) = binormal_jacobians::<P>(
         frames.edge[i - 1],
         frames.edge[i],
         frames.curvature_binormal[i],
         frames.inverse_denominator[i],
     );
-    let aa = gram(&a, &a);
-    let cc = gram(&c, &c);
-    let ac = gram(&a, &c);
+    let aa = gram::<P>(&a, &a);
+    let cc = gram::<P>(&c, &c);
+    let ac = gram::<P>(&a, &c);
     // ∇ψ_i = γ_k κ̃b on the triple (holonomy_gradient).
     let (t_prev, t_next) = (frames.tangent[i - 1], frames.tangent[i]);
-    let kb_unit = t_prev.cross(t_next) * (2.0 / (1.0 + t_prev.dot(t_next)));
-    let first = 0.5 * frames.inverse_length[i - 1];
-    let last = -0.5 * frames.inverse_length[i];
+    let kb_unit = t_prev.cross(t_next) * (P::R::of(2.0) / (P::R::ONE + t_prev.dot(t_next)));
+    let first = P::R::of(0.5) * frames.inverse_length[i - 1];
+    let last = P::R::of(-0.5) * frames.inverse_length[i];
     let middle = -(first + last);
-    let kk = outer(kb_unit);
+    let kk = outer::<P>(kb_unit);
     // Axial term of segment i (nodes i, i + 1).
-    let axial = AXIAL_PENALTY * 0.5 * (mass[i] + mass[i + 1]);
-    let tt = outer(t_next);
+    let axial = P::R::of(AXIAL_PENALTY * 0.5) * (mass[i] + mass[i + 1]);
+    let tt = outer::<P>(t_next);
     let hol = [
         holonomy * first * first,
         holonomy * middle * first,
@@ -274,7 +294,7 @@ fn node_blocks<M: Math, const N: usize>(
         holonomy * last * middle,
         holonomy * last * last,
     ];
-    let mut blocks = [[[0.0; 3]; 3]; 6];
+    let mut blocks = [[[P::R::ZERO; 3]; 3]; 6];
     for p in 0..3 {
         for q in 0..3 {
             // J = (−A, A − C, C): J_aᵀJ_b from AᵀA, CᵀC, AᵀC (ac[q][p] = c_p·a_q).
@@ -293,8 +313,8 @@ fn node_blocks<M: Math, const N: usize>(
 
 /// `u uᵀ`.
 #[inline(always)]
-fn outer(u: Vec3) -> [[Real; 3]; 3] {
-    let [x, y, z] = u.to_array();
+fn outer<P: Kernel>(u: P::V) -> [[P::R; 3]; 3] {
+    let [x, y, z] = u.components();
     [
         [x * x, x * y, x * z],
         [y * x, y * y, y * z],
@@ -305,7 +325,7 @@ fn outer(u: Vec3) -> [[Real; 3]; 3] {
 /// Adds `block` to the rows `rows` of one node at column node `OFFSET` nodes back (lower
 /// triangle only on the diagonal block). Constant offsets: no run-time index checks.
 #[inline(always)]
-fn add_block<const OFFSET: usize>(rows: &mut [BandRow; 3], block: &[[Real; 3]; 3]) {
+fn add_block<R: Arithmetic, const OFFSET: usize>(rows: &mut [BandRow<R>; 3], block: &[[R; 3]; 3]) {
     for (p, row) in rows.iter_mut().enumerate() {
         for (q, value) in block[p].iter().enumerate() {
             if OFFSET == 0 && q > p {
@@ -319,15 +339,15 @@ fn add_block<const OFFSET: usize>(rows: &mut [BandRow; 3], block: &[[Real; 3]; 3
 /// One row `r ≥ BAND` of the `L D Lᵀ` factorisation: `previous[k]` is the factored row
 /// `r − BAND + k`, `inverse_pivot[k]` its `1/D`. Returns `1/D(r)`.
 #[inline(always)]
-fn factor_row(
-    row: &mut BandRow,
-    previous: &[BandRow; BAND],
-    inverse_pivot: &[Real; BAND],
-    mass_floor: Real,
-) -> Real {
+fn factor_row<R: Arithmetic>(
+    row: &mut BandRow<R>,
+    previous: &[BandRow<R>; BAND],
+    inverse_pivot: &[R; BAND],
+    mass_floor: R,
+) -> R {
     // ld[m] = L(r, r − m) D(r − m), filled from the farthest column in. (Exclusive ranges:
     // `a..=b` iterates with an extra check per step.)
-    let mut ld = [0.0; BAND + 1];
+    let mut ld = [R::ZERO; BAND + 1];
     for m in (1..BAND + 1).rev() {
         let column = &previous[BAND - m];
         let mut sum = row[m];
@@ -351,41 +371,39 @@ fn factor_row(
     // modified Cholesky factorisation. The factor stays positive definite and the solve
     // finite; in that direction the step is stiffer than the model. A system f32 resolves
     // never reaches the floor, so its bits are unchanged (every recorded hash holds).
-    let relative = PIVOT_RESOLUTION * diagonal;
-    // A comparison, not `f32::max`: that is a library call on the Cortex-M4F.
-    let floor = if relative > mass_floor {
-        relative
-    } else {
-        mass_floor
-    };
-    if pivot.is_nan() || pivot < floor {
-        pivot = floor;
-    }
+    // Selects, not branches (and not `f32::max`, a library call on the Cortex-M4F): a NaN
+    // pivot fails `floor ≤ pivot` and takes the floor.
+    let relative = R::of(PIVOT_RESOLUTION) * diagonal;
+    let floor = larger(mass_floor, relative);
+    pivot = R::select(floor.le(pivot), pivot, floor);
     row[0] = pivot;
-    1.0 / pivot
+    R::ONE / pivot
 }
 
 /// The smallest of `mass` beyond the held nodes 0 and 1 (∞ when there is none).
-fn lightest(mass: &[Real]) -> Real {
-    mass.iter().skip(2).fold(Real::INFINITY, |m, x| m.min(*x))
+fn lightest<R: Arithmetic>(mass: &[R]) -> R {
+    let infinity = R::of(Real::INFINITY);
+    mass.iter()
+        .skip(2)
+        .fold(infinity, |m, x| R::select(x.lt(m), *x, m))
 }
 
-impl<const N: usize> BendingSystem<N> {
+impl<P: Kernel, const N: usize> BendingSystem<P, N> {
     /// Assembles `M + h² H̃` for the strand of `frames` (see the module documentation) with
     /// node masses `mass`, the stiffnesses of `rest` and the step `h`.
-    pub fn assemble<M: Math>(
+    pub fn assemble(
         &mut self,
-        frames: &RodFrames<M, N>,
-        mass: &[Real; N],
-        rest: &RodRest<N>,
-        h: Real,
+        frames: &RodFrames<P, N>,
+        mass: &[P::R; N],
+        rest: &RodRest<N, P::R>,
+        h: P::R,
     ) {
         let nodes = frames.nodes.min(N);
         self.nodes = nodes;
-        self.pivot_floor = 0.5 * lightest(&mass[..nodes]);
+        self.pivot_floor = P::R::of(0.5) * lightest(&mass[..nodes]);
         for (i, rows) in self.band.iter_mut().enumerate().take(nodes) {
-            let diagonal = if i >= 2 { mass[i] } else { 1.0 };
-            let mut row = [0.0; BAND + 1];
+            let diagonal = if i >= 2 { mass[i] } else { P::R::ONE };
+            let mut row = [P::R::ZERO; BAND + 1];
             row[0] = diagonal;
             *rows = [row; 3];
         }
@@ -396,30 +414,30 @@ impl<const N: usize> BendingSystem<N> {
             .take(nodes.saturating_sub(1))
             .skip(1)
         {
-            let blocks = node_blocks(frames, mass, rest, i, h, *weight);
+            let blocks = node_blocks(frames, (mass, rest), i, h, *weight);
             let [b00, b10, b11, b20, b21, b22] = &blocks;
             // Rows and columns of the held nodes 0 and 1 are not unknowns.
             if i >= 3 {
                 if let Some(rows) = self.band.get_mut(i - 1) {
-                    add_block::<0>(rows, b00);
+                    add_block::<_, 0>(rows, b00);
                 }
             }
             if i >= 2 {
                 if let Some(rows) = self.band.get_mut(i) {
                     if i >= 3 {
-                        add_block::<1>(rows, b10);
+                        add_block::<_, 1>(rows, b10);
                     }
-                    add_block::<0>(rows, b11);
+                    add_block::<_, 0>(rows, b11);
                 }
             }
             if let Some(rows) = self.band.get_mut(i + 1) {
                 if i >= 3 {
-                    add_block::<2>(rows, b20);
+                    add_block::<_, 2>(rows, b20);
                 }
                 if i >= 2 {
-                    add_block::<1>(rows, b21);
+                    add_block::<_, 1>(rows, b21);
                 }
-                add_block::<0>(rows, b22);
+                add_block::<_, 0>(rows, b22);
             }
         }
     }
@@ -428,12 +446,12 @@ impl<const N: usize> BendingSystem<N> {
     /// with `held_velocity` (the head's motion over the step, which the root coupling gives
     /// them), so a stiff strand turns with the head within the step instead of lagging a step
     /// behind it. Subtracts `h² H̃_{free,held} v_held` from `rhs`.
-    pub fn move_held_nodes<M: Math>(
-        frames: &RodFrames<M, N>,
-        rest: &RodRest<N>,
-        h: Real,
-        held_velocity: [Vec3; 2],
-        rhs: &mut [[Real; 3]; N],
+    pub fn move_held_nodes(
+        frames: &RodFrames<P, N>,
+        rest: &RodRest<N, P::R>,
+        h: P::R,
+        held_velocity: [P::V; 2],
+        rhs: &mut [[P::R; 3]; N],
     ) {
         let nodes = frames.nodes.min(N);
         let holonomy = holonomy_weights(frames, rest, h);
@@ -443,15 +461,18 @@ impl<const N: usize> BendingSystem<N> {
             let s = node_weight(rest, i, h);
             let j = node_jacobian(frames, i);
             let g = holonomy_gradient(frames, i);
-            let apply = |m: &[Vec3; 3], v: Vec3| m[0] * v.x + m[1] * v.y + m[2] * v.z;
+            let apply = |m: &[P::V; 3], v: P::V| {
+                let [x, y, z] = v.components();
+                m[0] * x + m[1] * y + m[2] * z
+            };
             // s J' v_held over the held nodes of the triple (i − 1 + k < 2).
-            let mut jv = Vec3::ZERO;
+            let mut jv = P::V::ZERO;
             for (k, jk) in j.iter().enumerate() {
                 if let Some(v) = held_velocity.get(i - 1 + k) {
                     jv += apply(jk, *v);
                 }
             }
-            let mut gv = 0.0;
+            let mut gv = P::R::ZERO;
             for (k, gk) in g.iter().enumerate() {
                 if let Some(v) = held_velocity.get(i - 1 + k) {
                     gv += gk.dot(*v);
@@ -464,7 +485,7 @@ impl<const N: usize> BendingSystem<N> {
                     continue;
                 }
                 if let Some(row) = rhs.get_mut(node) {
-                    let gk = gk.to_array();
+                    let gk = gk.components();
                     for ((slot, column), gkp) in row.iter_mut().zip(jk).zip(gk) {
                         *slot -= column.dot(jv) + gkp * gv;
                     }
@@ -483,7 +504,7 @@ impl<const N: usize> BendingSystem<N> {
         let rows = (3 * self.nodes).min(band.len()).min(inverse_pivot.len());
         let floor = self.pivot_floor;
         for slot in inverse_pivot.iter_mut().take(FIRST_ROW) {
-            *slot = 1.0;
+            *slot = P::R::ONE;
         }
         for r in FIRST_ROW..rows {
             let (done, rest) = band.split_at_mut(r);
@@ -493,15 +514,15 @@ impl<const N: usize> BendingSystem<N> {
             };
             let start = r.saturating_sub(BAND);
             let windows = (
-                <&[BandRow; BAND]>::try_from(&done[start..]),
-                <&[Real; BAND]>::try_from(&pivots_done[start..]),
+                <&[BandRow<P::R>; BAND]>::try_from(&done[start..]),
+                <&[P::R; BAND]>::try_from(&pivots_done[start..]),
             );
             *pivot = match windows {
                 (Ok(previous), Ok(pivots)) => factor_row(row, previous, pivots, floor),
                 // The first rows (r < BAND): the same with a shorter reach.
                 _ => {
-                    let mut previous = [[0.0; BAND + 1]; BAND];
-                    let mut pivots = [1.0; BAND];
+                    let mut previous = [[P::R::ZERO; BAND + 1]; BAND];
+                    let mut pivots = [P::R::ONE; BAND];
                     let reach = r - start;
                     for k in 0..reach {
                         previous[BAND - reach + k] = done[start + k];
@@ -515,7 +536,7 @@ impl<const N: usize> BendingSystem<N> {
 
     /// Solves `L D Lᵀ z = rhs` in place after [`Self::factor`]; the held nodes' entries are
     /// left as they are (zero in the step).
-    pub fn solve(&self, rhs: &mut [[Real; 3]; N]) {
+    pub fn solve(&self, rhs: &mut [[P::R; 3]; N]) {
         let band = self.band.as_flattened();
         let inverse_pivot = self.inverse_pivot.as_flattened();
         let z = rhs.as_flattened_mut();
@@ -549,6 +570,21 @@ impl<const N: usize> BendingSystem<N> {
     }
 }
 
+/// What the implicit step reads of the strands it moves besides their nodes: the masses, the
+/// rod's rest data, and the elastic and external forces with the step `h`.
+pub struct Loads<'a, P: Kernel, const N: usize> {
+    /// `m` per node.
+    pub mass: &'a [P::R; N],
+    /// The rod's rest data.
+    pub rest: &'a RodRest<N, P::R>,
+    /// The elastic forces at the step's start (Kmoch Sec. 7.2).
+    pub forces: &'a [P::V; N],
+    /// The external forces.
+    pub external: &'a External<P>,
+    /// The caller's accelerations per node, if any.
+    pub accelerations: Option<&'a [P::V]>,
+}
+
 /// Kmoch 2009 Algorithm 1 line 4 as one linearly implicit step of `h = dt` for the bending
 /// (see the module documentation): `(M + h² H̃) v⁺ = M (v + h a)` and `x⁺ = x + h v⁺`, with
 /// `a` the acceleration of the explicit step from the elastic forces `forces` and the
@@ -564,37 +600,53 @@ pub fn step<M: Math, const N: usize>(
     held_velocity: [Vec3; 2],
     accelerations: Option<&[Vec3]>,
 ) {
-    let h = ctx.dt;
-    let n = strand.rest.nodes.min(N);
-    let mut system = BendingSystem::<N>::default();
-    system.assemble(frames, &strand.rest.mass, &strand.rest.rod, h);
-    system.factor();
-    let external = External::<M>::of(ctx);
-    // Right-hand side M (v + h a), with a as in the explicit step.
-    let mut rhs = [[0.0; 3]; N];
     let state = &mut strand.state;
     let rest = &strand.rest;
-    let nodes = rhs
-        .iter_mut()
-        .zip(&state.velocity)
-        .zip(forces.iter().zip(rest.mass.iter().zip(&rest.inverse_mass)))
-        .enumerate()
-        .take(n)
-        .skip(2);
-    for (i, ((slot, v), (force, (mass, inverse_mass)))) in nodes {
-        let a = external.acceleration(*force, *v, *inverse_mass, accelerations, i);
-        *slot = ((*v + a * h) * *mass).to_array();
+    let nodes = Nodes::<M, N> {
+        count: rest.nodes.min(N),
+        position: &mut state.position,
+        velocity: &mut state.velocity,
+        inverse_mass: &rest.inverse_mass,
+    };
+    let external = External::<M>::of(ctx);
+    let loads = Loads {
+        mass: &rest.mass,
+        rest: &rest.rod,
+        forces,
+        external: &external,
+        accelerations,
+    };
+    step_nodes(nodes, &loads, frames, (ctx.dt, held_velocity), true);
+}
+
+/// [`step`] of one strand's nodes or of `W` strands' in lanes (`lane::Lanes`): the same
+/// operations on each lane. Lanes outside `active` keep their positions and velocities (a
+/// strand in a block that takes the explicit substeps): `true` for one strand.
+pub fn step_nodes<P: Kernel, const N: usize>(
+    nodes: Nodes<'_, P, N>,
+    loads: &Loads<'_, P, N>,
+    frames: &RodFrames<P, N>,
+    (h, held_velocity): (P::R, [P::V; 2]),
+    active: <P::R as Arithmetic>::Mask,
+) {
+    let n = nodes.count.min(N);
+    let mut system = BendingSystem::<P, N>::default();
+    system.assemble(frames, loads.mass, loads.rest, h);
+    system.factor();
+    // Right-hand side M (v + h a), with a as in the explicit step.
+    let mut rhs = [[P::R::ZERO; 3]; N];
+    for (i, slot) in rhs.iter_mut().enumerate().take(n).skip(2) {
+        let v = nodes.velocity[i];
+        let (force, inverse_mass) = (loads.forces[i], nodes.inverse_mass[i]);
+        let a = (loads.external).acceleration(force, v, inverse_mass, loads.accelerations, i);
+        *slot = ((v + a * h) * loads.mass[i]).components();
     }
-    BendingSystem::move_held_nodes(frames, &rest.rod, h, held_velocity, &mut rhs);
+    BendingSystem::move_held_nodes(frames, loads.rest, h, held_velocity, &mut rhs);
     system.solve(&mut rhs);
-    let nodes = rhs
-        .iter()
-        .zip(state.velocity.iter_mut().zip(state.position.iter_mut()))
-        .take(n)
-        .skip(2);
-    for (solved, (v, x)) in nodes {
-        *v = Vec3::from_array(*solved);
-        *x += *v * h;
+    for (i, solved) in rhs.iter().enumerate().take(n).skip(2) {
+        let (v, x) = (P::V::from_components(*solved), nodes.position[i]);
+        nodes.velocity[i] = P::V::select(active, v, nodes.velocity[i]);
+        nodes.position[i] = P::V::select(active, x + v * h, x);
     }
 }
 

@@ -73,7 +73,7 @@ fn stiff(factor: f32) -> Material {
 
 /// The symmetric dense matrix of a system's band (before factoring), all `3·NODES` rows
 /// (held rows and columns zero).
-fn dense(system: &BendingSystem<NODES>) -> Vec<Vec<f64>> {
+fn dense(system: &BendingSystem<Libm, NODES>) -> Vec<Vec<f64>> {
     let rows = 3 * system.nodes;
     let band = system.band.as_flattened();
     let mut a = vec![vec![0.0f64; rows]; rows];
@@ -89,13 +89,17 @@ fn dense(system: &BendingSystem<NODES>) -> Vec<Vec<f64>> {
 }
 
 /// `M + h² H̃` (or `h² H̃` alone with `massless`) of `strand` at `positions`.
-fn system_at(strand: &Strand<NODES>, positions: &[Vec3], massless: bool) -> BendingSystem<NODES> {
+fn system_at(
+    strand: &Strand<NODES>,
+    positions: &[Vec3],
+    massless: bool,
+) -> BendingSystem<Libm, NODES> {
     let frames = RodFrames::<Libm, NODES>::compute(
         positions,
         strand.state.root_frame,
         &strand.rest.rod.rest_length,
     );
-    let mut system = BendingSystem::<NODES>::default();
+    let mut system = BendingSystem::<Libm, NODES>::default();
     let mass = if massless {
         [0.0; NODES]
     } else {
