@@ -59,6 +59,7 @@ pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
 pub use params::{DftlCoefficients, DftlParams, Mode, Params, WindParams};
 pub use pipeline::dftl::step_blocks;
 pub use pipeline::rod::RodScratch;
+pub use pipeline::rod_lanes::RodBlockScratch;
 pub use pipeline::{
     step_strands, step_strands_in_lanes, step_strands_in_lanes_with, step_strands_with,
 };

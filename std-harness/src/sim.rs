@@ -15,11 +15,11 @@
 use hairsim_core::context::StepContext;
 use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
 use hairsim_core::params::DftlCoefficients;
+use hairsim_core::pipeline::step_strands_with;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
-use hairsim_core::projection::lanes::BlockProjection;
 use hairsim_core::{
-    step_blocks, step_strands, step_strands_in_lanes, step_strands_in_lanes_with, Collider, Grab,
-    Math, Params, Pose, Real, Solver, Stage, StepReport, Strand, Vec3,
+    step_blocks, step_strands, step_strands_in_lanes_with, Collider, Grab, Math, Params, Pose,
+    Real, RodBlockScratch, RodScratch, Solver, Stage, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -86,15 +86,13 @@ pub struct Sim<const N: usize, M: Math> {
     /// DFTL only: each block of `block` strands as `block.div_ceil(LANES)` SoA blocks, in
     /// strand order (rest data loaded once; the state copied in and out every step).
     dftl_blocks: Vec<DftlBlock<LANES, N>>,
-    /// How the strands are stepped.
-    layout: Layout,
     dftl: DftlCoefficients,
     accelerations: Vec<Vec3>,
     /// One report per block of strands, reused every step (a step allocates nothing).
     block_reports: Vec<StepReport>,
-    /// The rod in lanes: the projection's scratch space of each block of strands, kept from
-    /// step to step (none for other solvers and layouts).
-    rod_scratch: Vec<Option<Box<BlockProjection<N, ROD_LANES>>>>,
+    /// The rod's scratch space of each block of strands, kept from step to step (none for
+    /// DFTL).
+    rod_scratch: Vec<KeptScratch<M, N>>,
     pool: Option<std::sync::Arc<rayon::ThreadPool>>,
     math: std::marker::PhantomData<M>,
 }
@@ -143,8 +141,9 @@ impl<const N: usize, M: Math> Sim<N, M> {
             _ => Vec::new(),
         };
         let blocks = strands.len().div_ceil(block);
-        let in_lanes = prepared.params.solver == Solver::Rod && layout == Layout::Blocks;
-        let rod_scratch = (0..blocks).map(|_| in_lanes.then(Box::default)).collect();
+        let rod_scratch = (0..blocks)
+            .map(|_| KeptScratch::of(prepared.params.solver, layout))
+            .collect();
         Ok(Sim {
             params: prepared.params,
             block_reports: vec![StepReport::default(); blocks],
@@ -162,7 +161,6 @@ impl<const N: usize, M: Math> Sim<N, M> {
             sph,
             block,
             dftl_blocks,
-            layout,
             // Computed once, as `World::configure` does (two divisions, never per step).
             dftl: prepared.params.dftl.at_step(prepared.params.dt),
             pool,
@@ -255,7 +253,6 @@ impl<const N: usize, M: Math> Sim<N, M> {
             block: self.block,
             grabs: &self.grabs,
             accelerations: hair_hair.then_some(self.accelerations.as_slice()),
-            lanes: self.layout == Layout::Blocks,
         };
         let reports = &mut self.block_reports;
         let parallel = self.pool.as_ref().filter(|_| reports.len() > 1);
@@ -278,8 +275,28 @@ struct Blocks<'a> {
     block: usize,
     grabs: &'a [Grab],
     accelerations: Option<&'a [Vec3]>,
+}
+
+/// The rod's scratch space of one block of strands: the lanes' (with the lanes' square root,
+/// [`VectorSqrt`]) or one strand's.
+enum KeptScratch<M: Math, const N: usize> {
     /// Rod strands in lanes of [`ROD_LANES`].
-    lanes: bool,
+    Blocks(Box<RodBlockScratch<VectorSqrt<M>, N, ROD_LANES>>),
+    /// Rod strands one at a time.
+    PerStrand(Box<RodScratch<M, N>>),
+    /// DFTL: none.
+    None,
+}
+
+impl<M: Math, const N: usize> KeptScratch<M, N> {
+    /// The scratch space `solver` stepped in `layout` uses.
+    fn of(solver: Solver, layout: Layout) -> Self {
+        match (solver, layout) {
+            (Solver::Rod, Layout::Blocks) => KeptScratch::Blocks(Box::default()),
+            (Solver::Rod, Layout::PerStrand) => KeptScratch::PerStrand(Box::default()),
+            (Solver::Dftl, _) => KeptScratch::None,
+        }
+    }
 }
 
 impl Blocks<'_> {
@@ -291,34 +308,31 @@ impl Blocks<'_> {
     }
 
     /// Every block of `strands` through the core's per-strand pipeline, the rod's in lanes
-    /// with each block's projection scratch of `scratch` (as many as `reports`).
+    /// or one strand at a time, with each block's scratch space of `scratch` (as many as
+    /// `reports`).
     fn per_strand<const N: usize, M: Math>(
         &self,
         strands: &mut [Strand<N>],
         reports: &mut [StepReport],
-        scratch: &mut [Option<Box<BlockProjection<N, ROD_LANES>>>],
+        scratch: &mut [KeptScratch<M, N>],
         parallel: Option<&std::sync::Arc<rayon::ThreadPool>>,
     ) {
-        type Scratch<const N: usize> = Option<Box<BlockProjection<N, ROD_LANES>>>;
         let step = |b: usize,
                     strands: &mut [Strand<N>],
-                    (r, s): (&mut StepReport, &mut Scratch<N>)| {
+                    (r, s): (&mut StepReport, &mut KeptScratch<M, N>)| {
             *r = StepReport::default();
             let acc = self.of_block::<N>(b, strands.len());
             let first = (b * self.block) as u32;
             let (ctx, grabs) = (self.ctx, self.grabs);
-            type L<M> = VectorSqrt<M>;
-            match (self.lanes, s) {
-                (true, Some(projection)) => {
-                    let at = (first, grabs);
-                    step_strands_in_lanes_with::<L<M>, N, ROD_LANES>(
-                        ctx, strands, at, acc, projection, r,
-                    );
+            let at = (first, grabs);
+            match s {
+                KeptScratch::Blocks(scratch) => {
+                    step_strands_in_lanes_with(ctx, strands, at, acc, scratch, r);
                 }
-                (true, None) => {
-                    step_strands_in_lanes::<L<M>, N, ROD_LANES>(ctx, strands, first, grabs, acc, r);
+                KeptScratch::PerStrand(scratch) => {
+                    step_strands_with::<M, N>(ctx, strands, at, acc, Some(scratch), r);
                 }
-                (false, _) => step_strands::<M, N>(ctx, strands, first, grabs, acc, r),
+                KeptScratch::None => step_strands::<M, N>(ctx, strands, first, grabs, acc, r),
             }
         };
         match parallel {

@@ -29,10 +29,10 @@ use crate::grab::{apply_slips, retarget, slip_unreachable, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Params};
-use crate::projection::lanes::BlockProjection;
 use crate::report::{Flags, StepReport};
 use crate::strand::Strand;
 use rod::RodScratch;
+use rod_lanes::RodBlockScratch;
 
 /// Steps a block of strands by one `ctx.dt` through its solver's pipeline. `first_strand` is
 /// the index of `strands[0]` in the whole scene (for grabs and the report); `accelerations`,
@@ -94,22 +94,21 @@ pub fn step_strands_in_lanes<M: Math, const N: usize, const W: usize>(
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
-    let mut projection = BlockProjection::<N, W>::default();
+    let mut scratch = RodBlockScratch::<M, N, W>::new();
     let at = (first_strand, grabs);
-    step_strands_in_lanes_with::<M, N, W>(ctx, strands, at, accelerations, &mut projection, report);
+    step_strands_in_lanes_with::<M, N, W>(ctx, strands, at, accelerations, &mut scratch, report);
 }
 
-/// [`step_strands_in_lanes`] with the projection's scratch space `projection` the caller
-/// keeps from step to step: it is tens of kilobytes, and building it each step took 2.4 % of
-/// Head #1's step in blocks. Every value the projection reads of it, it has written in the
-/// same call (the blocks of one call already share it), so the scratch's past never reaches
-/// the bits.
+/// [`step_strands_in_lanes`] with the scratch space `scratch` the caller keeps from step to
+/// step ([`rod_lanes::RodBlockScratch`]: the lanes, their frames and the projections' scratch,
+/// tens of kilobytes). Every value a block's step reads of it, it has written in the same
+/// call, so the scratch's past never reaches the bits.
 pub fn step_strands_in_lanes_with<M: Math, const N: usize, const W: usize>(
     ctx: &StepContext,
     strands: &mut [Strand<N>],
     (first_strand, grabs): (u32, &[Grab]),
     accelerations: Option<&[Vec3]>,
-    projection: &mut BlockProjection<N, W>,
+    scratch: &mut RodBlockScratch<M, N, W>,
     report: &mut StepReport,
 ) {
     if ctx.params.solver != Solver::Rod {
@@ -119,7 +118,7 @@ pub fn step_strands_in_lanes_with<M: Math, const N: usize, const W: usize>(
         let first = b * W.max(1);
         let accelerations = accelerations.and_then(|a| a.get(first * N..(first + block.len()) * N));
         let at = (grabs, first_strand + first as u32);
-        rod_lanes::step_block::<M, N, W>(block, ctx, at, accelerations, projection, report);
+        rod_lanes::step_block::<M, N, W>(block, ctx, at, accelerations, scratch, report);
     }
 }
 

@@ -87,8 +87,8 @@ pub fn step_strand<M: Math, const N: usize>(
 /// strand's step sets what it reads): made for each strand, its zeros and copies were 5 % of
 /// the Cortex-M4F's rod step (`firmware/profile.py`).
 pub struct RodScratch<M: Math, const N: usize> {
-    frames: RodFrames<M, N>,
-    projection: BlockProjection<N, 1>,
+    pub(super) frames: RodFrames<M, N>,
+    pub(super) projection: BlockProjection<N, 1>,
 }
 
 impl<M: Math, const N: usize> RodScratch<M, N> {

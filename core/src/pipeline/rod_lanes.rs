@@ -36,43 +36,83 @@ use crate::root_coupling::held_velocity;
 use crate::strand::Strand;
 
 use super::rod::{
-    begin, couple_root, integrate, judge, starting_from, twist_alone, Begun, Starting,
+    begin, couple_root, integrate, judge, starting_from, twist_alone, Begun, RodScratch, Starting,
 };
+
+/// Scratch space for [`step_block`], kept by the caller from step to step: the lanes, their
+/// frames, one strand's frames and projection (for the strands that step alone), and the
+/// projection's lanes. Built for each block, their zeros and copies were 7 % of Head #1's
+/// step in blocks (`perf`). Nothing in it carries from one block or step to the next: each
+/// block's step sets what it reads (the lanes are cleared as they are gathered).
+pub struct RodBlockScratch<M: Math, const N: usize, const W: usize> {
+    /// The block's lanes.
+    block: LaneBlock<N, W>,
+    /// The lanes' frames.
+    lane_frames: RodFrames<Lanes<M, W>, N>,
+    /// One strand's frames and projection.
+    strand: RodScratch<M, N>,
+    /// The projection's lanes.
+    projection: BlockProjection<N, W>,
+}
+
+impl<M: Math, const N: usize, const W: usize> RodBlockScratch<M, N, W> {
+    /// Before its first use.
+    #[must_use]
+    pub const fn new() -> Self {
+        RodBlockScratch {
+            block: LaneBlock::EMPTY,
+            lane_frames: RodFrames::empty(),
+            strand: RodScratch::new(),
+            projection: BlockProjection::new(),
+        }
+    }
+}
+
+impl<M: Math, const N: usize, const W: usize> Default for RodBlockScratch<M, N, W> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<M: Math, const N: usize, const W: usize> core::fmt::Debug for RodBlockScratch<M, N, W> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("RodBlockScratch")
+    }
+}
 
 /// Steps `strands` (at most `W`) by `ctx.dt`, as [`super::rod::step_strand`] steps each, with
 /// the same bits. `first_strand` is the index of `strands[0]` in the scene; `accelerations`,
-/// if any, holds `N` per strand. `projection` is scratch space, made once for many blocks.
+/// if any, holds `N` per strand. `scratch` is scratch space, made once for many blocks.
 pub fn step_block<M: Math, const N: usize, const W: usize>(
     strands: &mut [Strand<N>],
     ctx: &StepContext,
     (grabs, first_strand): (&[Grab], u32),
     accelerations: Option<&[Vec3]>,
-    projection: &mut BlockProjection<N, W>,
+    scratch: &mut RodBlockScratch<M, N, W>,
     report: &mut StepReport,
 ) {
     let count = strands.len().min(W);
     let strands = &mut strands[..count];
     // Sec. 5: the lanes' frames of the configuration the step starts from.
-    let mut step = BlockStep::<M, N, W>::gather(strands, ctx, accelerations);
+    let mut step = BlockStep::<M, N, W>::gather(strands, ctx, accelerations, scratch);
     // Snapshot, clamped set, what the step keeps, the plan: strand by strand.
     step.begin(strands, ctx, grabs, first_strand, report);
     // Lines 3–4: in lanes, or alone.
     step.integrate(strands, ctx, accelerations, report);
     // Lines 5–11, strand by strand.
-    step.finish(strands, ctx, (grabs, first_strand), projection, report);
+    step.finish(strands, ctx, (grabs, first_strand), report);
 }
 
 /// A block's step in the making: its lanes, their frames, and each strand's start.
-struct BlockStep<M: Math, const N: usize, const W: usize> {
+struct BlockStep<'s, M: Math, const N: usize, const W: usize> {
     /// Which strands are in the lanes: those with the first one's node count, when strands
     /// have frames (bending or twist on).
     gathered: [bool; W],
-    /// The lanes, when two strands or more are in them.
-    block: Option<LaneBlock<N, W>>,
-    /// The lanes' frames of the configuration the step starts from.
-    lane_frames: RodFrames<Lanes<M, W>, N>,
-    /// One strand's frames, for the strands that step alone and for the twist.
-    frames: Option<RodFrames<M, N>>,
+    /// Whether the lanes hold a block: two strands or more in them.
+    lanes: bool,
+    /// The lanes, their frames (of the configuration the step starts from), one strand's
+    /// frames (for the strands that step alone and for the twist) and the projections.
+    scratch: &'s mut RodBlockScratch<M, N, W>,
     /// Each strand's start.
     begun: [Option<Begun<M, N>>; W],
     /// The substeps each lane takes in the block (0: none there).
@@ -83,25 +123,29 @@ struct BlockStep<M: Math, const N: usize, const W: usize> {
     angles: [[[Real; 2]; N]; W],
 }
 
-impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
-    /// The lanes of `strands` and their frames.
-    fn gather(strands: &[Strand<N>], ctx: &StepContext, accelerations: Option<&[Vec3]>) -> Self {
+impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
+    /// The lanes of `strands` and their frames, in `scratch`.
+    fn gather(
+        strands: &[Strand<N>],
+        ctx: &StepContext,
+        accelerations: Option<&[Vec3]>,
+        scratch: &'s mut RodBlockScratch<M, N, W>,
+    ) -> Self {
         let nodes = strands.first().map_or(0, |s| s.rest.nodes);
         let gathered: [bool; W] = core::array::from_fn(|l| {
             ctx.gates.frames && strands.get(l).is_some_and(|s| s.rest.nodes == nodes)
         });
-        let block = (gathered.iter().filter(|&&g| g).count() > 1)
-            .then(|| LaneBlock::<N, W>::gather::<M>(strands, &gathered, accelerations));
-        let mut lane_frames = RodFrames::<Lanes<M, W>, N>::empty();
-        if let Some(block) = &block {
+        let lanes = gathered.iter().filter(|&&g| g).count() > 1;
+        if lanes {
+            let block = &mut scratch.block;
+            block.gather::<M>(strands, &gathered, accelerations);
             let (position, rest_length) = (&block.position[..block.nodes], &block.rest.rest_length);
-            lane_frames.recompute(position, block.root_frame, rest_length);
+            (scratch.lane_frames).recompute(position, block.root_frame, rest_length);
         }
         BlockStep {
             gathered,
-            block,
-            lane_frames,
-            frames: ctx.gates.frames.then(RodFrames::empty),
+            lanes,
+            scratch,
             begun: [const { None }; W],
             substeps: [0; W],
             implicit: [false; W],
@@ -119,11 +163,18 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         first_strand: u32,
         report: &mut StepReport,
     ) {
+        let has_frames = ctx.gates.frames;
+        let RodBlockScratch {
+            block,
+            lane_frames,
+            strand: alone,
+            ..
+        } = &mut *self.scratch;
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
             let index = first_strand + lane as u32;
-            let started = match (&self.block, self.frames.as_mut()) {
-                (Some(block), Some(scratch)) if self.gathered[lane] => {
-                    let (frames, rest_length) = (&self.lane_frames, &block.rest.rest_length);
+            let started = match (self.lanes, has_frames.then_some(&mut alone.frames)) {
+                (true, Some(scratch)) if self.gathered[lane] => {
+                    let (frames, rest_length) = (&*lane_frames, &block.rest.rest_length);
                     let starting = Starting {
                         has_frames: true,
                         smallest_denominator: |_: &Strand<N>| {
@@ -161,7 +212,7 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         self.implicit = core::array::from_fn(|lane| {
             let implicit = |b: &Begun<M, N>| b.integration == Integration::Implicit;
             let started = self.begun[lane].as_ref().is_some_and(implicit);
-            self.block.is_some() && self.gathered[lane] && started
+            self.lanes && self.gathered[lane] && started
         });
     }
 
@@ -178,26 +229,40 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
             .begun
             .each_ref()
             .map(|b| b.as_ref().map_or_else(Default::default, |b| b.clamped));
-        if let (Some(block), true) = (self.block.as_mut(), self.implicit.contains(&true)) {
-            let (frames, implicit) = (&self.lane_frames, &self.implicit);
-            implicit_in_lanes(block, frames, (strands, implicit), ctx, &clamped, report);
+        let RodBlockScratch {
+            block,
+            lane_frames,
+            strand: alone,
+            ..
+        } = &mut *self.scratch;
+        if self.lanes && self.implicit.contains(&true) {
+            let implicit = &self.implicit;
+            implicit_in_lanes(
+                block,
+                lane_frames,
+                (strands, implicit),
+                ctx,
+                &clamped,
+                report,
+            );
             block.scatter(strands, implicit, &mut self.angles);
         }
-        if let (Some(block), true) = (self.block.as_mut(), self.substeps.iter().any(|&k| k > 0)) {
-            let (frames, substeps) = (&mut self.lane_frames, &self.substeps);
-            explicit_substeps_in_lanes(block, frames, ctx, &clamped, substeps, report);
+        if self.lanes && self.substeps.iter().any(|&k| k > 0) {
+            let substeps = &self.substeps;
+            explicit_substeps_in_lanes(block, lane_frames, ctx, &clamped, substeps, report);
             block.scatter(strands, &substeps.map(|k| k > 0), &mut self.angles);
         }
         let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
-            let alone = self.substeps[lane] == 0 && !self.implicit[lane];
-            let Some(begun) = self.begun[lane].as_ref().filter(|_| alone) else {
+            let on_its_own = self.substeps[lane] == 0 && !self.implicit[lane];
+            let Some(begun) = self.begun[lane].as_ref().filter(|_| on_its_own) else {
                 continue;
             };
-            if let Some(frames) = self.frames.as_mut() {
-                frames.refresh(strand);
-            }
-            let (frames, acc) = (self.frames.as_mut(), of_strand(lane));
+            let frames = ctx.gates.frames.then(|| {
+                alone.frames.refresh(strand);
+                &mut alone.frames
+            });
+            let acc = of_strand(lane);
             self.angles[lane] = integrate(strand, ctx, begun, frames, acc, report);
         }
     }
@@ -210,7 +275,6 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
         strands: &mut [Strand<N>],
         ctx: &StepContext,
         (grabs, first_strand): (&[Grab], u32),
-        projection: &mut BlockProjection<N, W>,
         report: &mut StepReport,
     ) {
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
@@ -218,15 +282,15 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
                 couple_root(strand, ctx, begun, report);
             }
         }
-        project(
-            strands,
-            &self.begun,
-            ctx,
-            grabs,
-            first_strand,
+        let RodBlockScratch {
+            block,
+            lane_frames,
+            strand: alone,
             projection,
-            report,
-        );
+        } = &mut *self.scratch;
+        let projections = (projection, &mut alone.projection);
+        let at = (grabs, first_strand);
+        project(strands, &self.begun, ctx, at, projections, report);
         // The twist in lanes for the strands in them that hold no segment but the root (a
         // grabbed segment's saved frame is transported strand by strand).
         let in_lanes: [bool; W] = core::array::from_fn(|lane| {
@@ -236,22 +300,15 @@ impl<M: Math, const N: usize, const W: usize> BlockStep<M, N, W> {
             free && self.gathered[lane]
         });
         let lanes_twist = ctx.gates.twist && in_lanes.iter().filter(|&&l| l).count() > 1;
-        if let (Some(block), true) = (self.block.as_mut(), lanes_twist) {
-            twist_in_lanes(
-                block,
-                &mut self.lane_frames,
-                strands,
-                &in_lanes,
-                ctx,
-                report,
-            );
+        if lanes_twist {
+            twist_in_lanes(block, lane_frames, strands, &in_lanes, ctx, report);
         }
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
             let Some(begun) = self.begun[lane].as_ref() else {
                 continue;
             };
             if !(lanes_twist && in_lanes[lane]) {
-                let frames = self.frames.as_mut();
+                let frames = ctx.gates.frames.then_some(&mut alone.frames);
                 twist_alone(strand, ctx, begun, frames, &self.angles[lane], report);
             }
             judge(strand, ctx, first_strand + lane as u32, begun, report);
@@ -266,9 +323,8 @@ fn project<M: Math, const N: usize, const W: usize>(
     strands: &mut [Strand<N>],
     begun: &[Option<Begun<M, N>>; W],
     ctx: &StepContext,
-    grabs: &[Grab],
-    first_strand: u32,
-    lanes: &mut BlockProjection<N, W>,
+    (grabs, first_strand): (&[Grab], u32),
+    (lanes, alone): (&mut BlockProjection<N, W>, &mut BlockProjection<N, 1>),
     report: &mut StepReport,
 ) {
     if !ctx.gates.projection {
@@ -281,8 +337,6 @@ fn project<M: Math, const N: usize, const W: usize>(
         begun[lane].is_some() && strands.get(lane).is_some_and(fits)
     });
     let in_lanes = taken.iter().filter(|&&t| t).count() > 1 && lanes.run::<M>(strands, &taken, ctx);
-    // The scratch space of the strands projected alone, made once if any is.
-    let mut alone: Option<BlockProjection<N, 1>> = None;
     for (lane, strand) in strands.iter_mut().enumerate().take(W) {
         if begun[lane].is_none() {
             continue;
@@ -292,12 +346,11 @@ fn project<M: Math, const N: usize, const W: usize>(
             lanes.finish::<M>(lane, strand, ctx, report);
             continue;
         }
-        let scratch = alone.get_or_insert_with(BlockProjection::default);
         if taken[lane] {
-            project_alone::<M, N>(strand, ctx, scratch, report);
+            project_alone::<M, N>(strand, ctx, alone, report);
         } else {
             let at = (grabs, first_strand + lane as u32);
-            project_strand::<M, N>(strand, ctx, at, scratch, report);
+            project_strand::<M, N>(strand, ctx, at, alone, report);
         }
     }
 }

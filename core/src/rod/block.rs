@@ -4,7 +4,7 @@
 //! gets the same bits in a block as on its own. The rest data is gathered every step with the
 //! state: it is a few values per node beside a few hundred operations per node and substep.
 
-use crate::lane::{Lane, Wide, V3};
+use crate::lane::{Wide, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::rod::frames::material_angles;
 use crate::strand::{RodRest, Strand};
@@ -32,26 +32,21 @@ pub struct LaneBlock<const N: usize, const W: usize> {
 }
 
 impl<const N: usize, const W: usize> LaneBlock<N, W> {
-    /// The strands of `strands` (at most `W`) that `gathered` names, in their lanes, with
-    /// their `accelerations` (`N` per strand of `strands`) if any. They have the same node
-    /// count; at least one is named. A lane left out holds a copy of a strand that is in, so
-    /// that it computes nothing out of range; it is never scattered back.
-    #[must_use]
-    pub fn gather<M: Math>(
-        strands: &[Strand<N>],
-        gathered: &[bool; W],
-        accelerations: Option<&[Vec3]>,
-    ) -> Self {
-        let any = gathered.iter().position(|&g| g).unwrap_or(0);
-        let nodes = strands.get(any).map_or(0, |s| s.rest.nodes.min(N));
-        let zero = Wide::splat(0.0);
-        let mut block = LaneBlock {
-            nodes,
-            position: [V3::zero(); N],
-            velocity: [V3::zero(); N],
+    /// No strand: every lane zero, `(cos θ, sin θ) = (1, 0)`.
+    pub const EMPTY: Self = {
+        let zero = Wide([0.0; W]);
+        let zeros = V3 {
+            x: zero,
+            y: zero,
+            z: zero,
+        };
+        LaneBlock {
+            nodes: 0,
+            position: [zeros; N],
+            velocity: [zeros; N],
             theta: [zero; N],
-            cos_sin: [[Wide::splat(1.0), zero]; N],
-            root_frame: V3::zero(),
+            cos_sin: [[Wide([1.0; W]), zero]; N],
+            root_frame: zeros,
             inverse_mass: [zero; N],
             rest: RodRest {
                 rest_length: [zero; N],
@@ -66,16 +61,42 @@ impl<const N: usize, const W: usize> LaneBlock<N, W> {
                 rest_curvature: [[[zero; 2]; 2]; N],
                 stable_time_step: zero,
             },
-            accelerations: accelerations.map(|_| [V3::zero(); N]),
-        };
+            accelerations: None,
+        }
+    };
+
+    /// Gathers the strands of `strands` (at most `W`) that `gathered` names into their
+    /// lanes, with their `accelerations` (`N` per strand of `strands`) if any, in place of
+    /// what the lanes held. They have the same node count; at least one is named. A lane left
+    /// out holds a copy of a strand that is in, so that it computes nothing out of range; it
+    /// is never scattered back.
+    ///
+    /// Every lane's entries below the node count are written here. Those past it keep
+    /// [`Self::EMPTY`]'s values: the lanes are cleared when the node count or the presence of
+    /// accelerations differs from the block gathered before (clearing them for every block
+    /// was 3 % of Head #1's step in blocks, `perf`).
+    pub fn gather<M: Math>(
+        &mut self,
+        strands: &[Strand<N>],
+        gathered: &[bool; W],
+        accelerations: Option<&[Vec3]>,
+    ) {
+        let any = gathered.iter().position(|&g| g).unwrap_or(0);
+        let nodes = strands.get(any).map_or(0, |s| s.rest.nodes.min(N));
+        if nodes != self.nodes || accelerations.is_some() != self.accelerations.is_some() {
+            *self = Self::EMPTY;
+            self.nodes = nodes;
+            if accelerations.is_some() {
+                self.accelerations = Some([V3::zero(); N]);
+            }
+        }
         for (lane, &is_in) in gathered.iter().enumerate() {
             let source = if is_in { lane } else { any };
             if let Some(strand) = strands.get(source) {
                 let extra = accelerations.and_then(|a| a.get(source * N..(source + 1) * N));
-                block.put::<M>(lane, strand, extra);
+                self.put::<M>(lane, strand, extra);
             }
         }
-        block
     }
 
     /// Writes `strand` (and its accelerations `extra`, if any) into lane `lane`.
