@@ -279,6 +279,21 @@ mod rod_blocks {
     }
 }
 
+/// The scratch tests' effects: bending, twist, inextensibility and collisions under gravity.
+fn scratch_test_params() -> hairsim_core::Params {
+    use hairsim_core::{Effect, Effects, Params};
+    Params {
+        effects: Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Bending,
+            Effect::Twist,
+            Effect::Inextensibility,
+            Effect::Collisions,
+        ]),
+        ..Params::DEFAULT
+    }
+}
+
 /// The harness keeps each block's `RodBlockScratch` (the lanes, their frames, the projections'
 /// scratch) from step to step. Nothing may carry over: blocks of two strands of 24, 13 and 19
 /// nodes (and one block mixing 24 and 13, whose strands step alone) share one scratch space
@@ -291,20 +306,10 @@ fn a_kept_block_scratch_carries_nothing_between_blocks_or_steps() {
     use hairsim_core::hash::state_hash;
     use hairsim_core::pipeline::step_strands_in_lanes_with;
     use hairsim_core::{
-        step_strands, Effect, Effects, Material, Params, Pose, Real, RodBlockScratch, Shake,
-        StepReport, Strand, Vec3,
+        step_strands, Material, Pose, Real, RodBlockScratch, Shake, StepReport, Strand, Vec3,
     };
     const N: usize = 24;
-    let p = Params {
-        effects: Effects::from_slice(&[
-            Effect::Gravity,
-            Effect::Bending,
-            Effect::Twist,
-            Effect::Inextensibility,
-            Effect::Collisions,
-        ]),
-        ..Params::DEFAULT
-    };
+    let p = scratch_test_params();
     let lengths = [24, 24, 13, 13, 19, 19, 24, 13];
     let strand = |s: usize| {
         let normal = Vec3::new(0.1 * s as Real - 0.4, 0.9, 0.2).normalize();
@@ -356,18 +361,9 @@ fn a_kept_block_scratch_carries_nothing_between_blocks_or_steps() {
 #[test]
 fn a_worlds_rod_scratch_carries_nothing_between_strands_or_steps() {
     use hairsim_core::collide::{Collider, Shape};
-    use hairsim_core::{Effect, Effects, Material, Params, Real, Shake, StepInput, Strand, Vec3};
+    use hairsim_core::{Material, Real, Shake, StepInput, Strand, Vec3};
     const N: usize = 24;
-    let params = Params {
-        effects: Effects::from_slice(&[
-            Effect::Gravity,
-            Effect::Bending,
-            Effect::Twist,
-            Effect::Inextensibility,
-            Effect::Collisions,
-        ]),
-        ..Params::DEFAULT
-    };
+    let params = scratch_test_params();
     let strand = |s: usize, nodes: usize| {
         let normal = Vec3::new(0.3 * s as Real - 0.3, 0.9, 0.2).normalize();
         let side = normal.cross(Vec3::Z).normalize();

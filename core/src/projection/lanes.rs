@@ -23,6 +23,7 @@ use crate::grab::{grabbed_nodes, Grab};
 use crate::lane::{Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
+use crate::precision::Vector;
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
@@ -167,11 +168,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     #[must_use]
     pub const fn new() -> Self {
         let zero = Wide([0.0; W]);
-        let zero3 = V3 {
-            x: zero,
-            y: zero,
-            z: zero,
-        };
+        let zero3 = <V3<Wide<W>> as Vector<Wide<W>>>::ZERO;
         BlockProjection {
             taken: [false; W],
             nodes: 0,

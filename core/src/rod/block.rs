@@ -6,6 +6,7 @@
 
 use crate::lane::{Wide, V3};
 use crate::math::{Math, Real, Vec3};
+use crate::precision::Vector;
 use crate::rod::frames::material_angles;
 use crate::strand::{RodRest, Strand};
 
@@ -35,11 +36,7 @@ impl<const N: usize, const W: usize> LaneBlock<N, W> {
     /// No strand: every lane zero, `(cos θ, sin θ) = (1, 0)`.
     pub const EMPTY: Self = {
         let zero = Wide([0.0; W]);
-        let zeros = V3 {
-            x: zero,
-            y: zero,
-            z: zero,
-        };
+        let zeros = <V3<Wide<W>> as Vector<Wide<W>>>::ZERO;
         LaneBlock {
             nodes: 0,
             position: [zeros; N],
