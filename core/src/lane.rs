@@ -241,8 +241,7 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     const FRAC_1_PI: Wide<W> = Wide([core::f32::consts::FRAC_1_PI; W]);
     #[inline(always)]
     fn sin_cos(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-        let both = x.0.map(M::sin_cos);
-        (Wide(both.map(|b| b.0)), Wide(both.map(|b| b.1)))
+        M::sin_cos_in_lanes(x)
     }
     #[inline(always)]
     fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {

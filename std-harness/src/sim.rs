@@ -14,6 +14,7 @@
 
 use hairsim_core::context::StepContext;
 use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
+use hairsim_core::lane::Wide;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::step_strands_with;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
@@ -52,6 +53,10 @@ impl<M: Math> Math for VectorSqrt<M> {
     #[inline(always)]
     fn atan2(y: Real, x: Real) -> Real {
         M::atan2(y, x)
+    }
+    #[inline(always)]
+    fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
+        M::sin_cos_in_lanes(x)
     }
 }
 

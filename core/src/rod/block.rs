@@ -4,7 +4,7 @@
 //! gets the same bits in a block as on its own. The rest data is gathered every step with the
 //! state: it is a few values per node beside a few hundred operations per node and substep.
 
-use crate::lane::{Wide, V3};
+use crate::lane::{Lanes, Wide, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::precision::Vector;
 use crate::rod::frames::material_angles;
@@ -91,13 +91,17 @@ impl<const N: usize, const W: usize> LaneBlock<N, W> {
             let source = if is_in { lane } else { any };
             if let Some(strand) = strands.get(source) {
                 let extra = accelerations.and_then(|a| a.get(source * N..(source + 1) * N));
-                self.put::<M>(lane, strand, extra);
+                self.put(lane, strand, extra);
             }
         }
+        // The material angles' sines and cosines, in lanes: the bits `material_angles` gives
+        // each strand.
+        let segments = self.nodes.saturating_sub(1);
+        self.cos_sin = material_angles::<Lanes<M, W>, N>(&self.theta[..segments]);
     }
 
     /// Writes `strand` (and its accelerations `extra`, if any) into lane `lane`.
-    fn put<M: Math>(&mut self, lane: usize, strand: &Strand<N>, extra: Option<&[Vec3]>) {
+    fn put(&mut self, lane: usize, strand: &Strand<N>, extra: Option<&[Vec3]>) {
         let (state, rest) = (&strand.state, &strand.rest);
         let nodes = self.nodes;
         for i in 0..nodes {
@@ -111,13 +115,9 @@ impl<const N: usize, const W: usize> LaneBlock<N, W> {
             }
         }
         self.root_frame.set_lane(lane, state.root_frame);
-        // The material angles' sines and cosines, as `material_angles` computes them.
         let segments = nodes.saturating_sub(1);
-        let angles = material_angles::<M, N>(&state.theta[..segments]);
-        for (j, [c, s]) in angles.into_iter().enumerate() {
-            self.theta[j].0[lane] = state.theta[j];
-            self.cos_sin[j][0].0[lane] = c;
-            self.cos_sin[j][1].0[lane] = s;
+        for (slot, theta) in self.theta.iter_mut().zip(&state.theta).take(segments) {
+            slot.0[lane] = *theta;
         }
         self.put_rest(lane, &rest.rod);
     }
