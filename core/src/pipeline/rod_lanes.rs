@@ -1,9 +1,10 @@
 //! The rod's pipeline on a block of `W` strands (Kmoch 2009 Algorithm 1, as
-//! [`super::rod::step_strand`] on each). The explicit substeps of lines 3–4, the frame passes,
-//! the fast manifold projection (line 9, `projection::lanes`) and the hair-optimised twist
-//! (lines 9–10) run for the block's strands at once, one per lane (`lane::Lanes`), through the
-//! very operations a strand runs alone, so every strand gets the bits it gets alone. The other
-//! stages run strand by strand: the snapshot and plan, root coupling, the guard.
+//! [`super::rod::step_strand`] on each). The explicit substeps and the linearly implicit step
+//! of lines 3–4, the frame passes, the fast manifold projection (line 9, `projection::lanes`)
+//! and the twist (lines 9–10, both methods) run for the block's strands at once, one per lane
+//! (`lane::Lanes`), through the very operations a strand runs alone, so every strand gets the
+//! bits it gets alone. The other stages run strand by strand: the snapshot and plan, root
+//! coupling, the guard.
 //!
 //! Strands that differ in their substep count are masked once they have taken theirs, and
 //! strands that differ in their projection iterations once they have converged; the strands
