@@ -12,7 +12,7 @@
 use core::marker::PhantomData;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
-use crate::math::{Math, Quat, Real, Vec3};
+use crate::math::{self, Math, Quat, Real, Vec3};
 use crate::precision::{Arithmetic, Kernel, Trigonometry, Vector};
 
 /// A scalar or a fixed-width bundle of scalars, operated on lane by lane.
@@ -241,7 +241,12 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     const FRAC_1_PI: Wide<W> = Wide([core::f32::consts::FRAC_1_PI; W]);
     #[inline(always)]
     fn sin_cos(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-        M::sin_cos_in_lanes(x)
+        if M::PLAIN_SIN_COS {
+            sin_cos_in_lanes(x)
+        } else {
+            let both = x.0.map(M::sin_cos);
+            (Wide(both.map(|b| b.0)), Wide(both.map(|b| b.1)))
+        }
     }
     #[inline(always)]
     fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {
@@ -621,9 +626,85 @@ pub fn not_finite_sum<T: Lane>(total: T) -> T {
     total - total
 }
 
+/// [`crate::math::sin_cos`] of each lane, with the bits it gives that lane: the same operations written
+/// over the lanes (the quadrant's integer work too), so that the compiler packs them; the
+/// lanes that `sin_cos` hands to libm (NaN, `|x| > 201`) are patched one by one, and a zero
+/// lane keeps its sign.
+#[inline(always)]
+#[must_use]
+pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
+    let q = x * Wide::splat(core::f32::consts::FRAC_2_PI);
+    // `q ∓ 0.5` as `q + (∓0.5)`: the same IEEE operation.
+    let n: [i32; W] = core::array::from_fn(|l| {
+        let half = if q.0[l] < 0.0 { -0.5 } else { 0.5 };
+        (q.0[l] + half) as i32
+    });
+    let m = Wide(n.map(|n| n as Real));
+    let [p0, p1, p2] = math::FRAC_PI_2_PARTS.map(Wide::splat);
+    let r = ((x - m * p0) - m * p1) - m * p2;
+    let z = r * r;
+    let [s0, s1, s2] = math::SIN_COEFFICIENTS.map(Wide::splat);
+    let [c0, c1, c2] = math::COS_COEFFICIENTS.map(Wide::splat);
+    let sin = r + r * z * (s0 + z * (s1 + z * s2));
+    let cos = (Wide::splat(1.0) - Wide::splat(0.5) * z) + z * z * (c0 + z * (c1 + z * c2));
+    // The quadrant and the zero lanes lane by lane, as `sin_cos` picks them.
+    let mut sin_out = [0.0; W];
+    let mut cos_out = [0.0; W];
+    for l in 0..W {
+        let (odd, half_turn) = (n[l] & 1 != 0, n[l] & 2 != 0);
+        let (s, c) = (sin.0[l], cos.0[l]);
+        let (s, c) = (if odd { c } else { s }, if odd { -s } else { c });
+        let (s, c) = (
+            if half_turn { -s } else { s },
+            if half_turn { -c } else { c },
+        );
+        // C's `sin(±0) = ±0`, as `sin_cos`.
+        let zero = x.0[l] == 0.0;
+        sin_out[l] = if zero { x.0[l] } else { s };
+        cos_out[l] = if zero { 1.0 } else { c };
+    }
+    let beyond = x.0.map(|x| x.is_nan() || x.abs() > math::SIN_COS_REDUCED);
+    if beyond.contains(&true) {
+        for l in (0..W).filter(|&l| beyond[l]) {
+            (sin_out[l], cos_out[l]) = libm::sincosf(x.0[l]);
+        }
+    }
+    (Wide(sin_out), Wide(cos_out))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sin_cos_in_lanes_gives_each_lane_the_bits_of_sin_cos() {
+        let specials = [
+            0.0,
+            -0.0,
+            Real::NAN,
+            Real::INFINITY,
+            -201.0,
+            201.0,
+            201.1,
+            -1.0e9,
+        ];
+        let mut checked = 0;
+        let mut check = |x: [Real; 4]| {
+            let (s, c) = sin_cos_in_lanes(Wide(x));
+            for (l, x) in x.iter().enumerate() {
+                let (sl, cl) = math::sin_cos(*x);
+                assert_eq!(s.0[l].to_bits(), sl.to_bits(), "sin {x}");
+                assert_eq!(c.0[l].to_bits(), cl.to_bits(), "cos {x}");
+            }
+            checked += 4;
+        };
+        for k in 0..100_000u32 {
+            let x = (k as Real - 50_000.0) * 0.004_1;
+            check([x, -x, x * 0.5, specials[k as usize % specials.len()]]);
+        }
+        assert_eq!(checked, 400_000);
+    }
+
     use crate::math::{self, Libm};
 
     #[test]

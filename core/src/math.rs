@@ -18,8 +18,6 @@
 
 pub use glam::{Mat3, Quat, Vec2, Vec3};
 
-use crate::lane::{Lane, Wide};
-
 /// The simulation's scalar type.
 pub type Real = f32;
 
@@ -35,14 +33,10 @@ pub trait Math: Copy + Default + 'static {
     /// Four-quadrant arctangent of `y / x`.
     fn atan2(y: Real, x: Real) -> Real;
 
-    /// [`Math::sin_cos`] of each of `W` lanes, with the bits it gives each lane alone. By
-    /// default lane by lane; a backend whose `sin_cos` is plain arithmetic gives the lanes'
-    /// form, which the compiler packs.
-    #[inline(always)]
-    fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-        let both = x.0.map(Self::sin_cos);
-        (Wide(both.map(|b| b.0)), Wide(both.map(|b| b.1)))
-    }
+    /// Whether `sin_cos` is this module's [`sin_cos`] (plain `f32` arithmetic): then the
+    /// lanes take it in their own form (`lane::sin_cos_in_lanes`, the same bits per lane),
+    /// which the compiler packs; otherwise lane by lane. Say `true` only for that function.
+    const PLAIN_SIN_COS: bool = false;
 
     /// Euclidean length of `v`, summed as `x² + y² + z²` left to right.
     #[inline(always)]
@@ -60,6 +54,7 @@ pub struct Libm;
 
 impl Math for Libm {
     const NAME: &'static str = "libm";
+    const PLAIN_SIN_COS: bool = true;
     #[inline(always)]
     fn sqrt(x: Real) -> Real {
         libm::sqrtf(x)
@@ -71,10 +66,6 @@ impl Math for Libm {
     #[inline(always)]
     fn atan2(y: Real, x: Real) -> Real {
         atan2(y, x)
-    }
-    #[inline(always)]
-    fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-        sin_cos_in_lanes(x)
     }
 }
 
@@ -139,13 +130,13 @@ pub fn unit<M: Math>(v: Vec3) -> Vec3 {
 
 /// `π/2` in three parts for [`sin_cos`]'s reduction (fdlibm's `pio2_1`, `pio2_2`, `pio2_2t`):
 /// the first two carry 17 significant bits, so `n · part` is exact for `|n| ≤ 2^7`.
-const FRAC_PI_2_PARTS: [Real; 3] = [1.570_785_5, 1.080_427_3e-5, 6.077_1e-11];
+pub(crate) const FRAC_PI_2_PARTS: [Real; 3] = [1.570_785_5, 1.080_427_3e-5, 6.077_1e-11];
 /// Largest `|x|` [`sin_cos`] reduces itself: `2^7 · π/2`.
-const SIN_COS_REDUCED: Real = 201.0;
+pub(crate) const SIN_COS_REDUCED: Real = 201.0;
 /// `sin r = r + r z (s₀ + z (s₁ + z s₂))` and `cos r = 1 − z/2 + z² (c₀ + z (c₁ + z c₂))` with
 /// `z = r²` on `[−π/4, π/4]`: Cephes' `sinf` and `cosf` fits.
-const SIN_COEFFICIENTS: [Real; 3] = [-1.666_665_5e-1, 8.332_161e-3, -1.951_529_6e-4];
-const COS_COEFFICIENTS: [Real; 3] = [4.166_664_6e-2, -1.388_731_6e-3, 2.443_315_7e-5];
+pub(crate) const SIN_COEFFICIENTS: [Real; 3] = [-1.666_665_5e-1, 8.332_161e-3, -1.951_529_6e-4];
+pub(crate) const COS_COEFFICIENTS: [Real; 3] = [4.166_664_6e-2, -1.388_731_6e-3, 2.443_315_7e-5];
 
 /// `(sin x, cos x)` in plain `f32` `+ − × ÷` (no fused multiply-add, no table, no `f64`), so
 /// the same bits on every target without a libm call: libm's `sincosf` works in `f64`, which a
@@ -190,52 +181,6 @@ pub fn sin_cos(x: Real) -> (Real, Real) {
         if half_turn { -cos } else { cos },
     );
     (sin, cos)
-}
-
-/// [`sin_cos`] of each lane, with the bits it gives that lane: the same operations written
-/// over the lanes (the quadrant's integer work too), so that the compiler packs them; the
-/// lanes that [`sin_cos`] hands to libm (NaN, `|x| > 201`) are patched one by one, and a zero
-/// lane keeps its sign.
-#[inline(always)]
-#[must_use]
-pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-    let q = x * Wide::splat(core::f32::consts::FRAC_2_PI);
-    // `q ∓ 0.5` as `q + (∓0.5)`: the same IEEE operation.
-    let n: [i32; W] = core::array::from_fn(|l| {
-        let half = if q.0[l] < 0.0 { -0.5 } else { 0.5 };
-        (q.0[l] + half) as i32
-    });
-    let m = Wide(n.map(|n| n as Real));
-    let [p0, p1, p2] = FRAC_PI_2_PARTS.map(Wide::splat);
-    let r = ((x - m * p0) - m * p1) - m * p2;
-    let z = r * r;
-    let [s0, s1, s2] = SIN_COEFFICIENTS.map(Wide::splat);
-    let [c0, c1, c2] = COS_COEFFICIENTS.map(Wide::splat);
-    let sin = r + r * z * (s0 + z * (s1 + z * s2));
-    let cos = (Wide::splat(1.0) - Wide::splat(0.5) * z) + z * z * (c0 + z * (c1 + z * c2));
-    // The quadrant and the zero lanes lane by lane, as `sin_cos` picks them.
-    let mut sin_out = [0.0; W];
-    let mut cos_out = [0.0; W];
-    for l in 0..W {
-        let (odd, half_turn) = (n[l] & 1 != 0, n[l] & 2 != 0);
-        let (s, c) = (sin.0[l], cos.0[l]);
-        let (s, c) = (if odd { c } else { s }, if odd { -s } else { c });
-        let (s, c) = (
-            if half_turn { -s } else { s },
-            if half_turn { -c } else { c },
-        );
-        // C's `sin(±0) = ±0`, as `sin_cos`.
-        let zero = x.0[l] == 0.0;
-        sin_out[l] = if zero { x.0[l] } else { s };
-        cos_out[l] = if zero { 1.0 } else { c };
-    }
-    let beyond = x.0.map(|x| x.is_nan() || x.abs() > SIN_COS_REDUCED);
-    if beyond.contains(&true) {
-        for l in (0..W).filter(|&l| beyond[l]) {
-            (sin_out[l], cos_out[l]) = libm::sincosf(x.0[l]);
-        }
-    }
-    (Wide(sin_out), Wide(cos_out))
 }
 
 /// `atan(t) / t = Σ a_k u^k` with `u = t² ∈ [0, 1]`, lowest power first: a Chebyshev fit of
@@ -437,35 +382,6 @@ pub fn shape_damping_retention(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sin_cos_in_lanes_gives_each_lane_the_bits_of_sin_cos() {
-        let specials = [
-            0.0,
-            -0.0,
-            Real::NAN,
-            Real::INFINITY,
-            -201.0,
-            201.0,
-            201.1,
-            -1.0e9,
-        ];
-        let mut checked = 0;
-        let mut check = |x: [Real; 4]| {
-            let (s, c) = sin_cos_in_lanes(Wide(x));
-            for (l, x) in x.iter().enumerate() {
-                let (sl, cl) = sin_cos(*x);
-                assert_eq!(s.0[l].to_bits(), sl.to_bits(), "sin {x}");
-                assert_eq!(c.0[l].to_bits(), cl.to_bits(), "cos {x}");
-            }
-            checked += 4;
-        };
-        for k in 0..100_000u32 {
-            let x = (k as Real - 50_000.0) * 0.004_1;
-            check([x, -x, x * 0.5, specials[k as usize % specials.len()]]);
-        }
-        assert_eq!(checked, 400_000);
-    }
 
     #[test]
     fn atan2_is_within_its_stated_accuracy_in_every_quadrant() {

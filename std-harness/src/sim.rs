@@ -14,7 +14,6 @@
 
 use hairsim_core::context::StepContext;
 use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
-use hairsim_core::lane::Wide;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::step_strands_with;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
@@ -42,6 +41,7 @@ pub struct VectorSqrt<M>(std::marker::PhantomData<M>);
 
 impl<M: Math> Math for VectorSqrt<M> {
     const NAME: &'static str = M::NAME;
+    const PLAIN_SIN_COS: bool = M::PLAIN_SIN_COS;
     #[inline(always)]
     fn sqrt(x: Real) -> Real {
         x.sqrt()
@@ -53,10 +53,6 @@ impl<M: Math> Math for VectorSqrt<M> {
     #[inline(always)]
     fn atan2(y: Real, x: Real) -> Real {
         M::atan2(y, x)
-    }
-    #[inline(always)]
-    fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-        M::sin_cos_in_lanes(x)
     }
 }
 
