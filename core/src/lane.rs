@@ -626,10 +626,10 @@ pub fn not_finite_sum<T: Lane>(total: T) -> T {
     total - total
 }
 
-/// [`crate::math::sin_cos`] of each lane, with the bits it gives that lane: the same operations written
-/// over the lanes (the quadrant's integer work too), so that the compiler packs them; the
-/// lanes that `sin_cos` hands to libm (NaN, `|x| > 201`) are patched one by one, and a zero
-/// lane keeps its sign.
+/// [`crate::math::sin_cos`] of each lane, with the bits it gives that lane: the same
+/// operations written over the lanes (the quadrant's integer work too), so that the compiler
+/// packs them; the lanes that `sin_cos` hands to libm (NaN, `|x| > 201`) are patched one by
+/// one, and a zero lane keeps its sign.
 #[inline(always)]
 #[must_use]
 pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
@@ -675,6 +675,7 @@ pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::{self, Libm};
 
     #[test]
     fn sin_cos_in_lanes_gives_each_lane_the_bits_of_sin_cos() {
@@ -704,8 +705,6 @@ mod tests {
         }
         assert_eq!(checked, 400_000);
     }
-
-    use crate::math::{self, Libm};
 
     #[test]
     fn lanes_match_the_scalar_helpers_bit_for_bit() {

@@ -403,8 +403,17 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 moving.0[l] = false;
             }
         }
-        for (x, dx) in self.position.iter_mut().zip(&self.step).take(n) {
-            *x = V3::select(moving, *x + *dx * scale, *x);
+        // Most iterations move every lane within its trust radius: `x + Δx · 1` is `x + Δx`
+        // to the bit, with no product and no select.
+        let whole_moves = moving.0.iter().all(|&m| m) && scale.0.iter().all(|&s| s == 1.0);
+        if whole_moves {
+            for (x, dx) in self.position.iter_mut().zip(&self.step).take(n) {
+                *x += *dx;
+            }
+        } else {
+            for (x, dx) in self.position.iter_mut().zip(&self.step).take(n) {
+                *x = V3::select(moving, *x + *dx * scale, *x);
+            }
         }
         for (l, book) in self.lanes.iter_mut().enumerate() {
             if !moving.0[l] {
@@ -460,16 +469,23 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
 
     /// The segments' share of `Δx`.
     fn segment_moves(&mut self) {
-        let n = self.nodes;
-        for i in 0..n {
+        let n = self.nodes.min(N);
+        // The loop split where a node's segments change (nodes 0 and 1 prescribed, the tip
+        // on one segment), so that the interior runs without branches: the same operations.
+        for step in self.step.iter_mut().take(n.min(2)) {
+            *step = V3::zero();
+        }
+        let (w, m, projected) = (&self.inverse_mass, &self.multipliers, &self.projected);
+        for i in 2..n.saturating_sub(1) {
             let mut delta = V3::zero();
-            if i >= 2 {
-                let w = self.inverse_mass[i];
-                delta -= self.projected[i - 2][1] * (w * self.multipliers[i - 2]);
-                if i + 2 <= n {
-                    delta -= self.projected[i - 1][0] * (w * self.multipliers[i - 1]);
-                }
-            }
+            delta -= projected[i - 2][1] * (w[i] * m[i - 2]);
+            delta -= projected[i - 1][0] * (w[i] * m[i - 1]);
+            self.step[i] = delta;
+        }
+        if n >= 3 {
+            let i = n - 1;
+            let mut delta = V3::zero();
+            delta -= projected[i - 2][1] * (w[i] * m[i - 2]);
             self.step[i] = delta;
         }
     }

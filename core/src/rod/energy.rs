@@ -106,21 +106,20 @@ pub fn elastic_energy<P: Trigonometry, const N: usize>(
     energy
 }
 
-/// `∂E_bend/∂θ^j` from node `i` (frame `j = i − 1 + k`): `(1/l̂_i)(ω₂ (Bδ)₁ − ω₁ (Bδ)₂)`, and
-/// the vector `(1/l̂_i)(m2^j (Bδ)₁ − m1^j (Bδ)₂) = ∂E/∂(κb)_i` from the same term.
+/// `∂E_bend/∂θ^j` from node `i` (frame `j = i − 1 + k`, `b` its [`bending_matrix`]):
+/// `(1/l̂_i)(ω₂ (Bδ)₁ − ω₁ (Bδ)₂)`, and the vector `(1/l̂_i)(m2^j (Bδ)₁ − m1^j (Bδ)₂) =
+/// ∂E/∂(κb)_i` from the same term.
 #[inline(always)]
 fn bending_terms<P: Kernel, const N: usize>(
     frames: &RodFrames<P, N>,
     rest: &RodRest<N, P::R>,
-    terms: ElasticTerms,
-    i: usize,
-    k: usize,
+    (i, k): (usize, usize),
+    b: [P::R; 2],
     cos_sin: [P::R; 2],
 ) -> (P::R, P::V) {
     let j = i - 1 + k;
     let omega = material_curvature(frames.bishop_curvature[i][k], cos_sin);
     let rest_omega = rest.rest_curvature[i][k];
-    let b = bending_matrix(rest, terms, j);
     let inv_l = rest.inverse_voronoi_length[i];
     let b_delta = [
         b[0] * (omega[0] - rest_omega[0]) * inv_l,
@@ -148,11 +147,13 @@ pub fn bending_twist_derivative<P: Kernel, const N: usize>(
 ) -> P::R {
     let n = frames.interior();
     let mut g = P::R::ZERO;
+    // Segment j's matrix, at both of its nodes.
+    let b = bending_matrix(rest, terms, j);
     if j >= 1 && j <= n {
-        g += bending_terms(frames, rest, terms, j, 1, cos_sin).0;
+        g += bending_terms(frames, rest, (j, 1), b, cos_sin).0;
     }
     if j < n {
-        g += bending_terms(frames, rest, terms, j + 1, 0, cos_sin).0;
+        g += bending_terms(frames, rest, (j + 1, 0), b, cos_sin).0;
     }
     g
 }
@@ -237,18 +238,30 @@ pub fn elastic_forces_with_angles<P: Kernel, C: ClampedLanes<P::R>, const N: usi
     let zero = <P::V as Vector<P::R>>::ZERO;
     let nodes = frames.nodes.min(forces.len()).min(theta.len() + 1);
     let n = nodes.saturating_sub(2);
-    for f in forces.iter_mut().take(nodes) {
-        *f = zero;
+    if n == 0 {
+        for f in forces.iter_mut().take(nodes) {
+            *f = zero;
+        }
+        return;
     }
     let two = P::R::of(2.0);
     // Holonomy weight suffix sum W_k = Σ_{j ≥ k} w_j, built from the tip.
     let mut suffix = P::R::ZERO;
     // ∂E_bend/∂θ^j from node j + 1 (frame j), carried down from the previous (k + 1) node.
     let mut carried = P::R::ZERO;
+    // The forces on nodes k + 1 and k, summed in registers and stored once each: the same
+    // additions in the same order as `+=` on the slice (node k + 1 takes node k + 2's share,
+    // its own, then node k's), without loading and storing three nodes per interior node.
+    let (mut ahead, mut here) = (zero, zero);
+    // Segment k's bending matrix, taken at node k + 1 and handed down to node k.
+    let mut b_segment = bending_matrix(rest, terms, n);
     for k in (1..=n).rev() {
         // Node k's bending terms in frames k − 1 and k.
-        let (g_prev, kb_gradient_prev) = bending_terms(frames, rest, terms, k, 0, cos_sin[k - 1]);
-        let (g_here, kb_gradient_here) = bending_terms(frames, rest, terms, k, 1, cos_sin[k]);
+        let (b_here, b_prev) = (b_segment, bending_matrix(rest, terms, k - 1));
+        b_segment = b_prev;
+        let (g_prev, kb_gradient_prev) =
+            bending_terms(frames, rest, (k, 0), b_prev, cos_sin[k - 1]);
+        let (g_here, kb_gradient_here) = bending_terms(frames, rest, (k, 1), b_here, cos_sin[k]);
         let kb_gradient = kb_gradient_prev + kb_gradient_here;
         // Segment k is now complete: ∂E_bend/∂θ^k = (node k, frame k) + (node k + 1, frame k).
         let bend_k = g_here + carried;
@@ -272,10 +285,12 @@ pub fn elastic_forces_with_angles<P: Kernel, C: ClampedLanes<P::R>, const N: usi
         let half_holonomy = kb * frames.holonomy_scale[k];
         let psi_prev = half_holonomy * frames.inverse_length[k - 1];
         let psi_next = -(half_holonomy * frames.inverse_length[k]);
-        forces[k - 1] += psi_prev * suffix - a;
-        forces[k + 1] += psi_next * suffix - c;
-        forces[k] += a + c - (psi_prev + psi_next) * suffix;
+        forces[k + 1] = ahead + (psi_next * suffix - c);
+        ahead = here + (a + c - (psi_prev + psi_next) * suffix);
+        here = zero + (psi_prev * suffix - a);
     }
+    forces[1] = ahead;
+    forces[0] = here;
 }
 
 #[cfg(test)]
