@@ -250,8 +250,8 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     }
     #[inline(always)]
     fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {
-        // A plain loop, not `array::from_fn`: the compiler kept the closure's call out of
-        // line in the twist's sweep, which ran a fifth slower for it.
+        // A plain loop, not `array::from_fn`: the compiler once left the closure out of line
+        // in the twist's sweep, and the host's rod blocks stepped 5 % slower for it.
         let mut angle = [0.0; W];
         for ((angle, &y), &x) in angle.iter_mut().zip(&y.0).zip(&x.0) {
             *angle = M::atan2(y, x);
