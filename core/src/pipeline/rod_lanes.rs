@@ -32,7 +32,7 @@ use crate::rod::twist::{
     hair_optimised_twist_with_angles, newton_twist_in_lanes, ClampedFrames, NewtonSettings,
     TwistMethod,
 };
-use crate::rod::{ClampedSegments, ElasticTerms};
+use crate::rod::{ClampedSegments, ElasticTerms, RootOnly};
 use crate::root_coupling::held_velocity;
 use crate::strand::Strand;
 
@@ -378,10 +378,8 @@ fn twist_in_lanes<M: Math, const N: usize, const W: usize>(
         &block.rest.rest_length,
     );
     let segments = nodes.saturating_sub(1);
-    let (terms, clamped) = (
-        ElasticTerms::of(&ctx.gates),
-        [ClampedSegments::ROOT_ONLY; W],
-    );
+    // The strands in lanes hold no segment but the root's (`in_lanes`).
+    let (terms, clamped) = (ElasticTerms::of(&ctx.gates), RootOnly);
     let theta = &mut block.theta[..segments];
     match ctx.params.rod.twist {
         TwistMethod::HairOptimised => {

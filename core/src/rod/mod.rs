@@ -125,6 +125,19 @@ impl<R: Scalar> ClampedLanes<R> for ClampedSegments {
     }
 }
 
+/// Strands that hold no segment but the root's, known when the code is compiled: their
+/// kernels (the twist of a block's strands in lanes) then carry no test of a clamped segment
+/// past the root at all, whatever the compiler makes of a set passed at run time.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RootOnly;
+
+impl<R: Arithmetic> ClampedLanes<R> for RootOnly {
+    #[inline(always)]
+    fn clamped(&self, segment: usize) -> R::Mask {
+        R::mask(segment == 0)
+    }
+}
+
 impl<const W: usize> ClampedLanes<Wide<W>> for [ClampedSegments; W] {
     #[inline(always)]
     fn clamped(&self, segment: usize) -> WideMask<W> {
