@@ -129,6 +129,10 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     lower: [Wide<W>; N],
     fresh: [Wide<W>; N],
     step: [V3<Wide<W>>; N],
+    /// Whether the last evaluation took the chain's forward elimination on the way
+    /// ([`Self::evaluate_and_eliminate`]); the pivots it dropped are then in `lower[0]`, which
+    /// the first row has no use for.
+    chained: bool,
     lanes: [Lane<N>; W],
 }
 
@@ -183,6 +187,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             lower: [zero; N],
             fresh: [zero; N],
             step: [zero3; N],
+            chained: false,
             lanes: [const { Lane::EMPTY }; W],
         }
     }
@@ -346,21 +351,32 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             residual: core::array::from_fn(|l| self.lanes[l].rows.residual),
             converged: core::array::from_fn(|l| self.lanes[l].rows.converged),
         };
-        for j in 1..self.nodes.saturating_sub(1) {
-            let (a, b) = (self.position[j], self.position[j + 1]);
-            let e = b - a;
-            let rest2 = self.rest_squared[j];
-            let value = e.dot(e) - rest2;
-            if !layout.residual_only {
-                let r = j - 1;
-                let gradient = e * two;
-                self.value[r] = value;
-                self.rhs[r] = value;
-                self.gradient[r] = gradient;
-                self.projected[r] = [-gradient, gradient];
-            }
-            if layout.measures_segments() {
-                met.meet(value, rest2, tolerance, (a, b));
+        // In fixed cost, with no contact in a running lane, nothing changes the rows between
+        // their evaluation and the chain's forward elimination: both run in one pass.
+        let contacts = self
+            .lanes
+            .iter()
+            .any(|b| b.running && b.rows.contact_count > 0);
+        self.chained = layout.fixed_cost && !layout.residual_only && !contacts;
+        if self.chained {
+            self.evaluate_and_eliminate(layout, tolerance, &mut met);
+        } else {
+            for j in 1..self.nodes.saturating_sub(1) {
+                let (a, b) = (self.position[j], self.position[j + 1]);
+                let e = b - a;
+                let rest2 = self.rest_squared[j];
+                let value = e.dot(e) - rest2;
+                if !layout.residual_only {
+                    let r = j - 1;
+                    let gradient = e * two;
+                    self.value[r] = value;
+                    self.rhs[r] = value;
+                    self.gradient[r] = gradient;
+                    self.projected[r] = [-gradient, gradient];
+                }
+                if layout.measures_segments() {
+                    met.meet(value, rest2, tolerance, (a, b));
+                }
             }
         }
         for (l, book) in self.lanes.iter_mut().enumerate() {
@@ -467,26 +483,17 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         (any_contact, longest2)
     }
 
-    /// The segments' share of `Δx`.
+    /// The segments' share of `Δx`: from the blocks the contacts' elimination left, or, after
+    /// [`Self::evaluate_and_eliminate`], from the gradients (without contacts the blocks are
+    /// `∓∇C`, and negation is exact: the same bits).
     fn segment_moves(&mut self) {
-        let n = self.nodes.min(N);
-        // The loop split where a node's segments change (nodes 0 and 1 prescribed, the tip
-        // on one segment), so that the interior runs without branches: the same operations.
-        for step in self.step.iter_mut().take(n.min(2)) {
-            *step = V3::zero();
-        }
-        let (w, m, projected) = (&self.inverse_mass, &self.multipliers, &self.projected);
-        for i in 2..n.saturating_sub(1) {
-            let mut delta = V3::zero();
-            delta -= projected[i - 2][1] * (w[i] * m[i - 2]);
-            delta -= projected[i - 1][0] * (w[i] * m[i - 1]);
-            self.step[i] = delta;
-        }
-        if n >= 3 {
-            let i = n - 1;
-            let mut delta = V3::zero();
-            delta -= projected[i - 2][1] * (w[i] * m[i - 2]);
-            self.step[i] = delta;
+        let (step, w, m) = (&mut self.step, &self.inverse_mass, &self.multipliers);
+        if self.chained {
+            let gradient = &self.gradient;
+            segment_moves_of(step, self.nodes, (w, m), |r| [-gradient[r], gradient[r]]);
+        } else {
+            let projected = &self.projected;
+            segment_moves_of(step, self.nodes, (w, m), |r| projected[r]);
         }
     }
 
@@ -500,12 +507,19 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         let mut dropped = [0; W];
         let mut finite = [false; W];
         for pass in 0..4 {
-            for (l, dropped) in dropped.iter_mut().enumerate() {
-                if solving.0[l] {
-                    *dropped = self.eliminate_contacts(l);
+            // After an evaluation that took the forward elimination (no contacts: nothing to
+            // eliminate, no tentative row), only the backward half is left.
+            let chain = if self.chained && pass == 0 {
+                dropped = [0; W];
+                self.back_substitute(solving, self.lower[0])
+            } else {
+                for (l, dropped) in dropped.iter_mut().enumerate() {
+                    if solving.0[l] {
+                        *dropped = self.eliminate_contacts(l);
+                    }
                 }
-            }
-            let chain = self.solve_chain(solving);
+                self.solve_chain(solving)
+            };
             let mut again = false;
             for (l, dropped) in dropped.iter_mut().enumerate() {
                 if !solving.0[l] {
@@ -583,48 +597,34 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     /// into the multipliers of the lanes `solving` names. Returns each lane's dropped pivots.
     fn solve_chain(&mut self, solving: WideMask<W>) -> [u32; W] {
         let count = self.nodes.saturating_sub(2);
-        let zero = Wide([0.0; W]);
         let w = &self.inverse_mass;
-        // Counted in the lanes (exact below 2^24 rows).
-        let mut dropped_rows = zero;
-        let (lower, fresh) = (&mut self.lower, &mut self.fresh);
-        // D, 1/D and z of the previous row (root → tip).
-        let (mut d_above, mut inverse_above, mut z_above) = (zero, zero, zero);
+        let mut forward = Forward::START;
         for r in 0..count {
-            let [p0, p1] = self.projected[r];
-            let diagonal = w[r + 1] * p0.dot(p0) + w[r + 2] * p1.dot(p1);
-            let mut z = self.rhs[r];
-            let mut d = diagonal;
+            let coupled = if r > 0 {
+                Some(self.projected[r - 1][1])
+            } else {
+                None
+            };
+            let masses = (w[r + 1], w[r + 2]);
+            let (lower, fresh) = forward.row(self.projected[r], masses, self.rhs[r], coupled);
             if r > 0 {
-                let below = w[r + 1] * p0.dot(self.projected[r - 1][1]);
-                lower[r] = below * inverse_above;
-                d -= lower[r] * lower[r] * d_above;
-                z -= lower[r] * z_above;
+                self.lower[r] = lower;
             }
-            // A pivot not clearly positive is dropped (`banded::factor`); NaN is not kept.
-            // Written without branches, `&` not `&&`, so that the lanes stay in registers.
-            let kept: [bool; W] = core::array::from_fn(|l| {
-                let (diagonal, d) = (diagonal.0[l], d.0[l]);
-                (diagonal > 0.0) & (d > PIVOT_RATIO * diagonal) & d.is_finite()
-            });
-            dropped_rows += Wide(kept.map(|k| if k { 0.0 } else { 1.0 }));
-            d = Wide(core::array::from_fn(|l| if kept[l] { d.0[l] } else { 0.0 }));
-            // `banded::reciprocal`: 1/d for a kept pivot, 0 for a dropped one.
-            let inverse = Wide(core::array::from_fn(|l| {
-                let (d, reciprocal) = (d.0[l], 1.0 / d.0[l]);
-                if d > 0.0 {
-                    reciprocal
-                } else {
-                    0.0
-                }
-            }));
-            fresh[r] = z * inverse;
-            (d_above, inverse_above, z_above) = (d, inverse, z);
+            self.fresh[r] = fresh;
         }
-        // Backward: Lᵀ y = u.
+        self.back_substitute(solving, forward.dropped)
+    }
+
+    /// The backward half of the chain's solve, `Lᵀ y = u`, after its forward elimination
+    /// ([`Self::solve_chain`]'s or [`Self::evaluate_and_eliminate`]'s) dropped `dropped`
+    /// pivots: the multipliers of the lanes `solving` names. Returns each lane's dropped
+    /// pivots.
+    fn back_substitute(&mut self, solving: WideMask<W>, dropped: Wide<W>) -> [u32; W] {
+        let count = self.nodes.saturating_sub(2);
+        let fresh = &mut self.fresh;
         for r in (1..count).rev() {
             let y = fresh[r];
-            fresh[r - 1] -= lower[r] * y;
+            fresh[r - 1] -= self.lower[r] * y;
         }
         for (old, &new) in self.multipliers.iter_mut().zip(fresh.iter()).take(count) {
             *old = Wide(core::array::from_fn(|l| {
@@ -635,7 +635,135 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 }
             }));
         }
-        dropped_rows.0.map(|d| d as u32)
+        dropped.0.map(|d| d as u32)
+    }
+
+    /// The segment rows' evaluation (as [`Self::evaluate`] without `residual_only`) and the
+    /// forward elimination of [`Self::solve_chain`] in one pass, for lanes without contacts:
+    /// each row's blocks are `∓∇C` and its right-hand side `C`, so the rows stay in registers
+    /// and only the gradients, `L` and `z/D` are stored; the same operations on the same
+    /// values, so the same bits. Out of line: only fixed cost takes it.
+    #[inline(never)]
+    fn evaluate_and_eliminate(&mut self, layout: Layout, tolerance: Real, met: &mut Met<W>) {
+        let two = Wide([2.0; W]);
+        let n = self.nodes.min(N);
+        let mut forward = Forward::START;
+        let mut above = V3::zero();
+        for j in 1..n.saturating_sub(1) {
+            let (a, b) = (self.position[j], self.position[j + 1]);
+            let e = b - a;
+            let rest2 = self.rest_squared[j];
+            let value = e.dot(e) - rest2;
+            let r = j - 1;
+            let gradient = e * two;
+            self.gradient[r] = gradient;
+            let masses = (self.inverse_mass[j], self.inverse_mass[j + 1]);
+            let coupled = (r > 0).then_some(above);
+            let (lower, fresh) = forward.row([-gradient, gradient], masses, value, coupled);
+            if r > 0 {
+                self.lower[r] = lower;
+            }
+            self.fresh[r] = fresh;
+            above = gradient;
+            if layout.measures_segments() {
+                met.meet(value, rest2, tolerance, (a, b));
+            }
+        }
+        self.lower[0] = forward.dropped;
+    }
+}
+
+/// The forward elimination of the chain's `L D Lᵀ`, root → tip, a row at a time: what
+/// [`BlockProjection::solve_chain`] and [`BlockProjection::evaluate_and_eliminate`] share.
+#[derive(Clone, Copy)]
+struct Forward<const W: usize> {
+    /// `D`, `1/D` and `z` of the previous row.
+    d_above: Wide<W>,
+    inverse_above: Wide<W>,
+    z_above: Wide<W>,
+    /// Pivots dropped so far, counted in the lanes (exact below 2^24 rows).
+    dropped: Wide<W>,
+}
+
+impl<const W: usize> Forward<W> {
+    const START: Self = Forward {
+        d_above: Wide([0.0; W]),
+        inverse_above: Wide([0.0; W]),
+        z_above: Wide([0.0; W]),
+        dropped: Wide([0.0; W]),
+    };
+
+    /// The next row: blocks `[p0, p1]` at its two nodes (inverse masses `w0`, `w1`),
+    /// right-hand side `rhs`, and `coupled`, the previous row's block at the node they share
+    /// (none for the first row). Returns its `L` below the diagonal (zero for the first row)
+    /// and `z/D`.
+    #[inline(always)]
+    fn row(
+        &mut self,
+        [p0, p1]: [V3<Wide<W>>; 2],
+        (w0, w1): (Wide<W>, Wide<W>),
+        rhs: Wide<W>,
+        coupled: Option<V3<Wide<W>>>,
+    ) -> (Wide<W>, Wide<W>) {
+        let diagonal = w0 * p0.dot(p0) + w1 * p1.dot(p1);
+        let mut z = rhs;
+        let mut d = diagonal;
+        let mut lower = Wide([0.0; W]);
+        if let Some(above) = coupled {
+            let below = w0 * p0.dot(above);
+            lower = below * self.inverse_above;
+            d -= lower * lower * self.d_above;
+            z -= lower * self.z_above;
+        }
+        // A pivot not clearly positive is dropped (`banded::factor`); NaN is not kept.
+        // Written without branches, `&` not `&&`, so that the lanes stay in registers.
+        let kept: [bool; W] = core::array::from_fn(|l| {
+            let (diagonal, d) = (diagonal.0[l], d.0[l]);
+            (diagonal > 0.0) & (d > PIVOT_RATIO * diagonal) & d.is_finite()
+        });
+        self.dropped += Wide(kept.map(|k| if k { 0.0 } else { 1.0 }));
+        let d = Wide(core::array::from_fn(|l| if kept[l] { d.0[l] } else { 0.0 }));
+        // `banded::reciprocal`: 1/d for a kept pivot, 0 for a dropped one.
+        let inverse = Wide(core::array::from_fn(|l| {
+            let (d, reciprocal) = (d.0[l], 1.0 / d.0[l]);
+            if d > 0.0 {
+                reciprocal
+            } else {
+                0.0
+            }
+        }));
+        (self.d_above, self.inverse_above, self.z_above) = (d, inverse, z);
+        (lower, z * inverse)
+    }
+}
+
+/// `Δx` of the first `nodes` nodes from the segments through them: `−w_i Σ p δλ` over the
+/// blocks `p` of the rows at node `i` (`blocks(r)`: row `r`'s at its first and second node),
+/// segment `i − 1` first, with the inverse masses and multipliers `(w, m)`. The loop is split
+/// where a node's segments change (nodes 0 and 1 prescribed, the tip on one segment), so that
+/// the interior runs without branches: the same operations.
+#[inline(always)]
+fn segment_moves_of<const N: usize, const W: usize>(
+    step: &mut [V3<Wide<W>>; N],
+    nodes: usize,
+    (w, m): (&[Wide<W>; N], &[Wide<W>; N]),
+    blocks: impl Fn(usize) -> [V3<Wide<W>>; 2],
+) {
+    let n = nodes.min(N);
+    for step in step.iter_mut().take(n.min(2)) {
+        *step = V3::zero();
+    }
+    for i in 2..n.saturating_sub(1) {
+        let mut delta = V3::zero();
+        delta -= blocks(i - 2)[1] * (w[i] * m[i - 2]);
+        delta -= blocks(i - 1)[0] * (w[i] * m[i - 1]);
+        step[i] = delta;
+    }
+    if n >= 3 {
+        let i = n - 1;
+        let mut delta = V3::zero();
+        delta -= blocks(i - 2)[1] * (w[i] * m[i - 2]);
+        step[i] = delta;
     }
 }
 
