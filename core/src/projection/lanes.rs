@@ -509,8 +509,8 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         for pass in 0..4 {
             // After an evaluation that took the forward elimination (no contacts: nothing to
             // eliminate, no tentative row), only the backward half is left.
+            // (`dropped` is still all zero in pass 0.)
             let chain = if self.chained && pass == 0 {
-                dropped = [0; W];
                 self.back_substitute(solving, self.lower[0])
             } else {
                 for (l, dropped) in dropped.iter_mut().enumerate() {
