@@ -431,13 +431,14 @@ mod tests {
     #[test]
     fn dftl_blocks_step_as_the_per_strand_path() {
         let mut scene = (crate::builtin::find("mannequin-b").unwrap().scene)();
-        scene.strands_per_block = Some(40);
+        scene.strands_per_block = Some(44);
         let prepared = scene.prepare().unwrap();
         let mut blocks = Sim::<16, DefaultMath>::new(&prepared, 2).unwrap();
         let mut per_strand =
             Sim::<16, DefaultMath>::with_layout(&prepared, 2, Layout::PerStrand).unwrap();
-        // 12 blocks of 40 strands (3 SoA blocks: 16 + 16 + 8 lanes), then 20 strands (16 + 4).
-        assert_eq!(blocks.dftl_blocks.len(), 12 * 3 + 2);
+        // 11 blocks of 44 strands (6 SoA blocks of 8 lanes, the last with 4 strands), then
+        // 16 strands (8 + 8).
+        assert_eq!(blocks.dftl_blocks.len(), 11 * 6 + 2);
         for k in 0..40 {
             let inputs = scene_inputs::<DefaultMath>(&prepared, k);
             let a = blocks.in_pool(|s| s.step(&inputs));

@@ -30,11 +30,14 @@ use crate::strand::Strand;
 
 use super::node::NodeInput;
 
-/// Lanes per block the harness should use on x86-64: measured fastest — on the SSE2 baseline
-/// 16 lanes ran ≈ 2.5× faster than 8 and than 32 (both spill far more), and with
-/// `-C target-cpu=x86-64-v3` (AVX2; the same bits: Rust never fuses a multiply-add) 16 lanes
-/// ran ≈ 1.3× faster again.
-pub const RECOMMENDED_LANES: usize = 16;
+/// Lanes per block the harness uses on x86-64. Since the lanes' masks are whole 32-bit lanes
+/// (`lane::WideMask`, 2026-12-05), 8 lanes run as fast as 16 did with byte masks, or faster:
+/// `dftl_cpu`'s medians of three runs, M vertex-steps per CPU-second, 8 lanes now against
+/// 16 then, DFTL + shape 66.7 / 57.1 (1,024 × 8), 66.6 / 64.5 (1,024 × 32), 60.4 / 58.6
+/// (4,096 × 32), 56.9 / 51.1 (4,096 × 64), 53.8 / 56.9 (16,384 × 64); 16 lanes with the new
+/// masks spill (each mask takes four SSE2 registers) and lost 5–15 %. Before, with masks of
+/// `bool`s, 16 lanes were the fastest on SSE2 and with AVX2 (the same bits either way).
+pub const RECOMMENDED_LANES: usize = 8;
 
 /// `W` values, one per strand of a block.
 pub type Lanes<const W: usize> = [Real; W];
@@ -289,7 +292,7 @@ fn lane_accelerations<const W: usize, const N: usize>(
                     has[l] = true;
                 }
             }
-            (extra, WideMask(has))
+            (extra, WideMask::from_bools(has))
         }
     }
 }

@@ -452,7 +452,13 @@ fn implicit_in_lanes<M: Math, const N: usize, const W: usize>(
         accelerations: block.accelerations.as_ref().map(|a| &a[..]),
     };
     let h = Wide::splat(ctx.dt);
-    step_nodes(lane_nodes, &loads, frames, (h, held), WideMask(*implicit));
+    step_nodes(
+        lane_nodes,
+        &loads,
+        frames,
+        (h, held),
+        WideMask::from_bools(*implicit),
+    );
 }
 
 /// Whether `k` substeps run without a projection between them (what the lanes do).
@@ -504,7 +510,7 @@ fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
             velocity: &mut block.velocity,
             inverse_mass: &block.inverse_mass,
         };
-        let active = WideMask(substeps.map(|k| substep < k));
+        let active = WideMask::from_bools(substeps.map(|k| substep < k));
         let acc = block.accelerations.as_ref().map(|a| &a[..]);
         symplectic_euler(lane_nodes, &external, &forces, h, acc, &mut motion, active);
     }

@@ -393,13 +393,13 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     fn solve_and_move<M: Math>(&mut self) {
         let n = self.nodes;
         let (dropped, finite) = self.solve();
-        let mut moving = WideMask([false; W]);
+        let mut moving = WideMask::from_bools([false; W]);
         for (l, book) in self.lanes.iter_mut().enumerate() {
             if !book.running {
                 continue;
             }
             if finite[l] {
-                moving.0[l] = true;
+                moving.set(l, true);
             } else {
                 book.outcome.dropped_rows += 1;
                 book.running = false;
@@ -408,7 +408,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         let (any_contact, longest2) = self.moves(moving);
         let mut scale = Wide([1.0; W]);
         for (l, book) in self.lanes.iter_mut().enumerate() {
-            if !moving.0[l] {
+            if !moving.get(l) {
                 continue;
             }
             if longest2[l].is_finite() {
@@ -416,12 +416,12 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             } else {
                 book.outcome.dropped_rows += 1;
                 book.running = false;
-                moving.0[l] = false;
+                moving.set(l, false);
             }
         }
         // Most iterations move every lane within its trust radius: `x + Δx · 1` is `x + Δx`
         // to the bit, with no product and no select.
-        let whole_moves = moving.0.iter().all(|&m| m) && scale.0.iter().all(|&s| s == 1.0);
+        let whole_moves = moving.to_bools().iter().all(|&m| m) && scale.0.iter().all(|&s| s == 1.0);
         if whole_moves {
             for (x, dx) in self.position.iter_mut().zip(&self.step).take(n) {
                 *x += *dx;
@@ -432,7 +432,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             }
         }
         for (l, book) in self.lanes.iter_mut().enumerate() {
-            if !moving.0[l] {
+            if !moving.get(l) {
                 continue;
             }
             if any_contact[l] {
@@ -457,7 +457,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         let n = self.nodes;
         let mut any_contact = [false; W];
         for (l, book) in self.lanes.iter().enumerate() {
-            if !moving.0[l] {
+            if !moving.get(l) {
                 continue;
             }
             for &i in book.rows.contact_nodes() {
@@ -503,7 +503,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     /// its multipliers are finite.
     fn solve(&mut self) -> ([u32; W], [bool; W]) {
         let n = self.nodes;
-        let mut solving = WideMask(core::array::from_fn(|l| self.lanes[l].running));
+        let mut solving = WideMask::from_bools(core::array::from_fn(|l| self.lanes[l].running));
         let mut dropped = [0; W];
         let mut finite = [false; W];
         for pass in 0..4 {
@@ -514,7 +514,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 self.back_substitute(solving, self.lower[0])
             } else {
                 for (l, dropped) in dropped.iter_mut().enumerate() {
-                    if solving.0[l] {
+                    if solving.get(l) {
                         *dropped = self.eliminate_contacts(l);
                     }
                 }
@@ -522,7 +522,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             };
             let mut again = false;
             for (l, dropped) in dropped.iter_mut().enumerate() {
-                if !solving.0[l] {
+                if !solving.get(l) {
                     continue;
                 }
                 *dropped += chain[l];
@@ -530,14 +530,14 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 finite[l] = self.multipliers[..count].iter().all(|m| m.0[l].is_finite());
                 let book = &mut self.lanes[l];
                 if !book.rows.tentative || !finite[l] {
-                    solving.0[l] = false;
+                    solving.set(l, false);
                     continue;
                 }
                 let (gradient, multipliers) = (&self.gradient, &self.multipliers);
                 let pull = |_: &Rows<N>, i| segment_pull(gradient, multipliers, n, i, l);
                 let inverse_mass = &book.nodes.inverse_mass;
                 if !prune_tentative(&mut book.rows, inverse_mass, n, pass >= 2, pull) {
-                    solving.0[l] = false;
+                    solving.set(l, false);
                     continue;
                 }
                 self.undo_elimination(l);
@@ -628,7 +628,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         }
         for (old, &new) in self.multipliers.iter_mut().zip(fresh.iter()).take(count) {
             *old = Wide(core::array::from_fn(|l| {
-                if solving.0[l] {
+                if solving.get(l) {
                     new.0[l]
                 } else {
                     old.0[l]

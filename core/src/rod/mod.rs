@@ -143,9 +143,9 @@ impl<const W: usize> ClampedLanes<Wide<W>> for [ClampedSegments; W] {
     fn clamped(&self, segment: usize) -> WideMask<W> {
         // Most blocks hold no grab: no lane's set to search.
         if self.iter().all(|set| set.count == 0) {
-            return WideMask([segment == 0; W]);
+            return WideMask::from_bools([segment == 0; W]);
         }
-        WideMask(core::array::from_fn(|lane| self[lane].contains(segment)))
+        WideMask::from_bools(core::array::from_fn(|lane| self[lane].contains(segment)))
     }
 }
 

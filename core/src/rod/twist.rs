@@ -454,7 +454,7 @@ impl<const W: usize> NewtonLanes<Wide<W>> {
     pub fn lane(&self, lane: usize) -> NewtonOutcome {
         NewtonLanes {
             iterations: self.iterations.0[lane],
-            converged: self.converged.0[lane],
+            converged: self.converged.get(lane),
             gauss_newton: self.gauss_newton.0[lane],
         }
         .outcome()
