@@ -315,9 +315,6 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     }
     #[inline(always)]
     fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {
-        if M::PLAIN_ATAN2 {
-            return atan2_in_lanes(y, x);
-        }
         // A plain loop, not `array::from_fn`: the compiler once left the closure out of line
         // in the twist's sweep, and the host's rod blocks stepped 5 % slower for it.
         let mut angle = [0.0; W];
@@ -748,44 +745,9 @@ pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
     (Wide(sin_out), Wide(cos_out))
 }
 
-/// [`crate::math::atan2`] of each pair of lanes, with the bits it gives that lane: its
-/// operations written over the lanes and its branches as selects, so that the compiler packs
-/// them (with this and [`floor_and_parity_in_lanes`] instead of four scalar calls each, the
-/// blocks' twist executes about 15 % fewer instructions). Every branch's
-/// value is computed and the untaken one dropped: a lane whose denominator is zero divides by
-/// it and takes the 0 the scalar function returns.
-#[inline(always)]
-#[must_use]
-pub fn atan2_in_lanes<const W: usize>(y: Wide<W>, x: Wide<W>) -> Wide<W> {
-    let (ax, ay) = (Lane::abs(x), Lane::abs(y));
-    let steep = Lane::lt(ax, ay);
-    let numerator = Lane::select(steep, ax, ay);
-    let denominator = Lane::select(steep, ay, ax);
-    let zero = Wide::splat(0.0);
-    let vertical = WideMask(lane_pairs(denominator.0, zero.0, |d, z| lane_mask(d == z)));
-    let t = Lane::select(vertical, zero, numerator / denominator);
-    let angle = math::atan_of_ratio(t, math::ATAN_COEFFICIENTS.map(Wide::splat));
-    let angle = Lane::select(
-        steep,
-        Wide::splat(core::f32::consts::FRAC_PI_2) - angle,
-        angle,
-    );
-    let angle = Lane::select(
-        sign_negative(x),
-        Wide::splat(core::f32::consts::PI) - angle,
-        angle,
-    );
-    Lane::select(sign_negative(y), -angle, angle)
-}
-
-/// The lanes whose sign bit is set (`-0.0` and negative NaNs included).
-#[inline(always)]
-fn sign_negative<const W: usize>(x: Wide<W>) -> WideMask<W> {
-    WideMask(lane_pairs(x.0, x.0, |x, _| lane_mask(x.is_sign_negative())))
-}
-
 /// [`crate::precision::Scalar::floor_and_parity`] of each lane, with its bits: the integer
-/// work in lanes (the truncation, the step down, the parity as a mask).
+/// work in lanes (the truncation, the step down, the parity as a mask). (`atan2` stays lane
+/// by lane: written over the lanes with selects, it made Head #1's blocks 5 % slower.)
 #[inline(always)]
 #[must_use]
 pub fn floor_and_parity_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, WideMask<W>) {
@@ -837,42 +799,6 @@ mod tests {
             check([x, -x, x * 0.5, specials[k as usize % specials.len()]]);
         }
         assert_eq!(checked, 400_000);
-    }
-
-    #[test]
-    fn atan2_in_lanes_gives_each_lane_the_bits_of_atan2() {
-        let specials = [
-            0.0,
-            -0.0,
-            Real::NAN,
-            -Real::NAN,
-            Real::INFINITY,
-            Real::NEG_INFINITY,
-            1.0e-38,
-            -3.0e38,
-        ];
-        let mut checked = 0;
-        for k in 0..40_000u32 {
-            let phi = (k as Real) * 0.000_17;
-            let radius = [1.0e-30, 3.0e-3, 1.0, 7.0e4][k as usize % 4];
-            let (y, x) = (radius * libm::sinf(phi), radius * libm::cosf(phi));
-            let special = specials[k as usize % specials.len()];
-            let ys = [y, -y, special, y];
-            let xs = [x, -x, x, special];
-            let angle = atan2_in_lanes(Wide(ys), Wide(xs));
-            for l in 0..4 {
-                let scalar = math::atan2(ys[l], xs[l]);
-                assert_eq!(
-                    angle.0[l].to_bits(),
-                    scalar.to_bits(),
-                    "{} {}",
-                    ys[l],
-                    xs[l]
-                );
-                checked += 1;
-            }
-        }
-        assert_eq!(checked, 160_000);
     }
 
     #[test]

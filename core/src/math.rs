@@ -37,9 +37,6 @@ pub trait Math: Copy + Default + 'static {
     /// lanes take it in their own form (`lane::sin_cos_in_lanes`, the same bits per lane),
     /// which the compiler packs; otherwise lane by lane. Say `true` only for that function.
     const PLAIN_SIN_COS: bool = false;
-    /// Whether `atan2` is this module's [`atan2`]: then the lanes take it in their own form
-    /// (`lane::atan2_in_lanes`, the same bits per lane). Say `true` only for that function.
-    const PLAIN_ATAN2: bool = false;
 
     /// Euclidean length of `v`, summed as `x² + y² + z²` left to right.
     #[inline(always)]
@@ -58,7 +55,6 @@ pub struct Libm;
 impl Math for Libm {
     const NAME: &'static str = "libm";
     const PLAIN_SIN_COS: bool = true;
-    const PLAIN_ATAN2: bool = true;
     #[inline(always)]
     fn sqrt(x: Real) -> Real {
         libm::sqrtf(x)
@@ -189,7 +185,7 @@ pub fn sin_cos(x: Real) -> (Real, Real) {
 
 /// `atan(t) / t = Σ a_k u^k` with `u = t² ∈ [0, 1]`, lowest power first: a Chebyshev fit of
 /// degree 8, rounded to f32 (in f32 its error is about 1e-7 rad for `t ∈ [0, 1]`).
-pub(crate) const ATAN_COEFFICIENTS: [Real; 9] = [
+const ATAN_COEFFICIENTS: [Real; 9] = [
     1.0,
     -0.333_330_36,
     0.199_918_72,
@@ -200,31 +196,6 @@ pub(crate) const ATAN_COEFFICIENTS: [Real; 9] = [
     -0.015_731_249,
     0.002_766_283_5,
 ];
-
-/// `atan(t)` for `t ∈ [0, 1]` from [`ATAN_COEFFICIENTS`] (passed as `a`, in the type of `t`),
-/// written once for a scalar and for lanes (`lane::atan2_in_lanes`), so both run the same
-/// operations in the same order.
-///
-/// Estrin's scheme, not Horner's: the same polynomial in four dependent steps after `u`
-/// instead of eight, which the sweep's independent segments then overlap.
-#[inline(always)]
-pub(crate) fn atan_of_ratio<T>(t: T, a: [T; 9]) -> T
-where
-    T: Copy + core::ops::Add<Output = T> + core::ops::Mul<Output = T>,
-{
-    let u = t * t;
-    let u2 = u * u;
-    let pairs = [
-        a[0] + a[1] * u,
-        a[2] + a[3] * u,
-        a[4] + a[5] * u,
-        a[6] + a[7] * u,
-    ];
-    let u4 = u2 * u2;
-    let quads = [pairs[0] + pairs[1] * u2, pairs[2] + pairs[3] * u2];
-    let p = (quads[0] + quads[1] * u4) + a[8] * (u4 * u4);
-    t * p
-}
 
 /// Four-quadrant arctangent of `y / x` in plain `+ − × ÷` (one division, no fused
 /// multiply-add, no table), so the same bits on every target without a libm call: the
@@ -247,7 +218,21 @@ pub fn atan2(y: Real, x: Real) -> Real {
     } else {
         numerator / denominator
     };
-    let mut angle = atan_of_ratio(t, ATAN_COEFFICIENTS);
+    // Estrin's scheme, not Horner's: the same polynomial in four dependent steps after `u`
+    // instead of eight, which the sweep's independent segments then overlap.
+    let a = &ATAN_COEFFICIENTS;
+    let u = t * t;
+    let u2 = u * u;
+    let pairs = [
+        a[0] + a[1] * u,
+        a[2] + a[3] * u,
+        a[4] + a[5] * u,
+        a[6] + a[7] * u,
+    ];
+    let u4 = u2 * u2;
+    let quads = [pairs[0] + pairs[1] * u2, pairs[2] + pairs[3] * u2];
+    let p = (quads[0] + quads[1] * u4) + a[8] * (u4 * u4);
+    let mut angle = t * p;
     if steep {
         angle = core::f32::consts::FRAC_PI_2 - angle;
     }
