@@ -20,10 +20,10 @@ use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Grab};
-use crate::lane::{Wide, WideMask, V3};
+use crate::lane::{Lane as _, Lanes, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
-use crate::precision::Vector;
+use crate::precision::{Kernel, Vector};
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
@@ -33,7 +33,7 @@ use super::constraints::{
 };
 use super::{
     conclude, free_nodes, layout_of, project_constraints, prune_tentative, push_on_colliders,
-    trust_radius, trust_scale, usable_colliders, Findings, NearColliders, Outcome,
+    record_outcome, trust_radius, trust_scale, usable_colliders, Findings, NearColliders, Outcome,
 };
 
 /// Whether strand `strand` (index `index` in the scene) can be projected in lanes with
@@ -115,8 +115,12 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     nodes: usize,
     position: [V3<Wide<W>>; N],
     inverse_mass: [Wide<W>; N],
-    /// `ê^j·ê^j` per segment.
+    /// `|ê^j|` and `ê^j·ê^j` per segment.
+    rest_length: [Wide<W>; N],
     rest_squared: [Wide<W>; N],
+    /// The positions the projection started from (`x̃`, the strands keep them until
+    /// [`Self::finish`]).
+    predicted: [V3<Wide<W>>; N],
     /// Row `r` (segment `r + 1`): `C`, the right-hand side after the contacts' elimination,
     /// `∇C` at the segment's second node, and the blocks at its two nodes after it.
     value: [Wide<W>; N],
@@ -129,6 +133,8 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     lower: [Wide<W>; N],
     fresh: [Wide<W>; N],
     step: [V3<Wide<W>>; N],
+    /// What [`Self::conclude`] measured of each lane's projected positions.
+    concluded: Concluded<W>,
     /// Whether the last evaluation took the chain's forward elimination on the way
     /// ([`Self::evaluate_and_eliminate`]); the pivots it dropped are then in `lower[0]`, which
     /// the first row has no use for.
@@ -178,7 +184,9 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             nodes: 0,
             position: [zero3; N],
             inverse_mass: [zero; N],
+            rest_length: [zero; N],
             rest_squared: [zero; N],
+            predicted: [zero3; N],
             value: [zero; N],
             rhs: [zero; N],
             gradient: [zero3; N],
@@ -187,6 +195,11 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             lower: [zero; N],
             fresh: [zero; N],
             step: [zero3; N],
+            concluded: Concluded {
+                finite: [false; W],
+                free_stretch: [0.0; W],
+                contact_stretch: [0.0; W],
+            },
             chained: false,
             lanes: [const { Lane::EMPTY }; W],
         }
@@ -229,10 +242,21 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 self.position[i].set_lane(l, strand.state.position[i]);
                 self.inverse_mass[i].0[l] = book.nodes.inverse_mass[i];
                 let rest = strand.rest.segment_length[i];
+                self.rest_length[i].0[l] = rest;
                 self.rest_squared[i].0[l] = rest * rest;
             }
         }
+        // One strand alone ends as `super::conclude` does (`Self::finish`): at one lane the
+        // ending's copies and selects cost more than they save (on the Cortex-M4F, 1.3 % more
+        // instructions a step for a strand draped over the head, `firmware/profile.py`).
+        let shared_ending = W > 1;
+        if shared_ending {
+            self.predicted[..nodes].copy_from_slice(&self.position[..nodes]);
+        }
         self.iterate::<M>(strands, ctx, shapes, layout);
+        if shared_ending {
+            self.conclude::<M>(ctx.inv_dt);
+        }
         true
     }
 
@@ -253,17 +277,81 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             report.ran(Stage::Collisions);
         }
         let n = self.nodes;
-        let predicted = strand.state.position;
-        for (x, lanes) in strand.state.position.iter_mut().zip(&self.position).take(n) {
-            *x = lanes.lane(lane);
-        }
         let findings = Findings {
             touched: &book.contacts.touched,
             max_depth: book.rows.max_depth,
             truncated: book.truncated,
             collider_push: &book.collider_push,
         };
-        conclude::<M, N>(strand, &predicted, ctx, book.outcome, findings, report)
+        if W == 1 || !self.concluded.finite[lane] {
+            // One strand alone, or an overflow on absurd input (rare): the strand's own
+            // ending, which keeps the positions it came in with if need be.
+            let predicted = strand.state.position;
+            for (x, lanes) in strand.state.position.iter_mut().zip(&self.position).take(n) {
+                *x = lanes.lane(lane);
+            }
+            return conclude::<M, N>(strand, &predicted, ctx, book.outcome, findings, report);
+        }
+        // `conclude`, with what `Self::conclude` measured in lanes: the same bits.
+        let state = &mut strand.state;
+        for (x, lanes) in state.position.iter_mut().zip(&self.position).take(n) {
+            *x = lanes.lane(lane);
+        }
+        report.ran(Stage::Velocity);
+        for (v, change) in state.velocity.iter_mut().zip(&self.step).take(n).skip(2) {
+            *v += change.lane(lane);
+        }
+        record_outcome(ctx, &book.outcome, &findings, n, report);
+        let concluded = &self.concluded;
+        report.max_stretch = report.max_stretch.max(concluded.free_stretch[lane]);
+        let at_contacts = concluded.contact_stretch[lane];
+        report.max_contact_stretch = report.max_contact_stretch.max(at_contacts);
+        book.outcome
+    }
+
+    /// The end of [`super::conclude`] that the lanes can share, for every lane at once: the
+    /// velocity change `(x − x̃)/h` of each node (into `step`, which the iterations are done
+    /// with), whether all of a lane's are finite, and the lane's largest stretch away from
+    /// and at contacts (`super::record`'s, by the same operations; a maximum does not depend
+    /// on the order its values come in).
+    fn conclude<M: Math>(&mut self, inv_dt: Real) {
+        let n = self.nodes.min(N);
+        let inv_dt = Wide::splat(inv_dt);
+        let mut finite = <Wide<W> as crate::lane::Lane>::mask(true);
+        for ((change, &x), &predicted) in self
+            .step
+            .iter_mut()
+            .zip(&self.position)
+            .zip(&self.predicted)
+            .take(n)
+        {
+            *change = (x - predicted) * inv_dt;
+            finite = finite & change.finite();
+        }
+        let touched = |l: usize, i: usize| self.lanes[l].contacts.touched[i] != 0;
+        let any_touched = (0..W).any(|l| (0..n).any(|i| touched(l, i)));
+        let zero = Wide::splat(0.0);
+        let (mut free, mut contact) = (zero, zero);
+        for j in 0..n.saturating_sub(1) {
+            let e = self.position[j + 1] - self.position[j];
+            let rest = self.rest_length[j];
+            let length = <Lanes<M, W> as Kernel>::sqrt(e.dot(e));
+            let stretch = (length - rest).abs() / rest;
+            if any_touched {
+                let at_contact = WideMask::from_bools(core::array::from_fn(|l| {
+                    touched(l, j) || touched(l, j + 1)
+                }));
+                contact = contact.max_where(at_contact, stretch);
+                free = free.max_where(!at_contact, stretch);
+            } else {
+                free = free.max(stretch);
+            }
+        }
+        self.concluded = Concluded {
+            finite: finite.to_bools(),
+            free_stretch: free.0,
+            contact_stretch: contact.0,
+        };
     }
 
     /// `super::iterate` in lanes: evaluate, test, solve, move, each lane until it stops.
@@ -765,6 +853,17 @@ fn segment_moves_of<const N: usize, const W: usize>(
         delta -= blocks(i - 2)[1] * (w[i] * m[i - 2]);
         step[i] = delta;
     }
+}
+
+/// What [`BlockProjection::conclude`] measured of each lane.
+#[derive(Clone, Copy)]
+struct Concluded<const W: usize> {
+    /// Whether every node's velocity change is finite.
+    finite: [bool; W],
+    /// The largest stretch `||e| − |ê|| / |ê|` of a segment with no node in contact, and of
+    /// one with a node in contact.
+    free_stretch: [Real; W],
+    contact_stretch: [Real; W],
 }
 
 /// Each lane's residual and convergence so far in an evaluation.

@@ -840,6 +840,30 @@ fn record<M: Math, const N: usize>(
     work: Findings<'_, N>,
     report: &mut StepReport,
 ) {
+    let n = strand.rest.nodes.min(N);
+    record_outcome(ctx, outcome, &work, n, report);
+    let x = &strand.state.position;
+    for j in 0..n.saturating_sub(1) {
+        let rest = strand.rest.segment_length[j];
+        let e = x[j + 1] - x[j];
+        let stretch = (M::length(e) - rest).abs() / rest;
+        if work.touched[j] != 0 || work.touched[j + 1] != 0 {
+            report.max_contact_stretch = report.max_contact_stretch.max(stretch);
+        } else {
+            report.max_stretch = report.max_stretch.max(stretch);
+        }
+    }
+}
+
+/// [`record`] but the stretch, of a strand of `n` nodes: iterations, residual, flags,
+/// contacts and collider forces.
+fn record_outcome<const N: usize>(
+    ctx: &StepContext,
+    outcome: &Outcome,
+    work: &Findings<'_, N>,
+    n: usize,
+    report: &mut StepReport,
+) {
     report.iterations_max = report.iterations_max.max(outcome.iterations);
     report.iterations_total += outcome.iterations;
     // `max` would hide a NaN residual; the guard rolls such a strand back anyway.
@@ -859,18 +883,6 @@ fn record<M: Math, const N: usize>(
         report.flags.insert(Flags::CONTACTS_TRUNCATED);
     }
     report.max_penetration = report.max_penetration.max(work.max_depth);
-    let n = strand.rest.nodes.min(N);
-    let x = &strand.state.position;
-    for j in 0..n.saturating_sub(1) {
-        let rest = strand.rest.segment_length[j];
-        let e = x[j + 1] - x[j];
-        let stretch = (M::length(e) - rest).abs() / rest;
-        if work.touched[j] != 0 || work.touched[j + 1] != 0 {
-            report.max_contact_stretch = report.max_contact_stretch.max(stretch);
-        } else {
-            report.max_stretch = report.max_stretch.max(stretch);
-        }
-    }
     report.contacts += work.touched.iter().take(n).filter(|&&t| t != 0).count() as u32;
     let inv_h2 = ctx.inv_dt * ctx.inv_dt;
     for (force, push) in report
