@@ -246,17 +246,9 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 self.rest_squared[i].0[l] = rest * rest;
             }
         }
-        // One strand alone ends as `super::conclude` does (`Self::finish`): at one lane the
-        // ending's copies and selects cost more than they save (on the Cortex-M4F, 1.3 % more
-        // instructions a step for a strand draped over the head, `firmware/profile.py`).
-        let shared_ending = W > 1;
-        if shared_ending {
-            self.predicted[..nodes].copy_from_slice(&self.position[..nodes]);
-        }
+        self.predicted[..nodes].copy_from_slice(&self.position[..nodes]);
         self.iterate::<M>(strands, ctx, shapes, layout);
-        if shared_ending {
-            self.conclude::<M>(ctx.inv_dt);
-        }
+        self.conclude::<M>(ctx.inv_dt);
         true
     }
 
@@ -283,9 +275,9 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             truncated: book.truncated,
             collider_push: &book.collider_push,
         };
-        if W == 1 || !self.concluded.finite[lane] {
-            // One strand alone, or an overflow on absurd input (rare): the strand's own
-            // ending, which keeps the positions it came in with if need be.
+        if !self.concluded.finite[lane] {
+            // An overflow on absurd input (rare): the strand's own ending, which keeps the
+            // positions it came in with.
             let predicted = strand.state.position;
             for (x, lanes) in strand.state.position.iter_mut().zip(&self.position).take(n) {
                 *x = lanes.lane(lane);
