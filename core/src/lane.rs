@@ -51,6 +51,8 @@ pub trait Lane:
     fn lt(self, other: Self) -> Self::Mask;
     /// Whether each lane is finite.
     fn finite(self) -> Self::Mask;
+    /// Whether each lane is NaN.
+    fn is_nan(self) -> Self::Mask;
     /// `if mask { a } else { b }` per lane.
     fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
     /// A mask with `value` in every lane.
@@ -92,6 +94,10 @@ impl Lane for Real {
     #[inline(always)]
     fn finite(self) -> bool {
         self.is_finite()
+    }
+    #[inline(always)]
+    fn is_nan(self) -> bool {
+        Real::is_nan(self)
     }
     #[inline(always)]
     fn select(mask: bool, a: Self, b: Self) -> Self {
@@ -360,6 +366,10 @@ impl<const W: usize> Lane for Wide<W> {
     #[inline(always)]
     fn finite(self) -> WideMask<W> {
         WideMask(lane_pairs(self.0, self.0, |x, _| lane_mask(x.is_finite())))
+    }
+    #[inline(always)]
+    fn is_nan(self) -> WideMask<W> {
+        WideMask(lane_pairs(self.0, self.0, |x, _| lane_mask(x.is_nan())))
     }
     /// The bits of `a` where `mask` is set, of `b` elsewhere: `(a & m) | (b & !m)`, exact.
     #[inline(always)]

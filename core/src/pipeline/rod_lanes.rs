@@ -26,7 +26,7 @@ use crate::rod::frames::RodFrames;
 use crate::rod::implicit::{step_nodes, Loads};
 use crate::rod::integrate::{starting_at, symplectic_euler, Nodes};
 use crate::rod::substeps::{
-    inextensibility_between_substeps, smallest_binormal_denominator_in_lane, Integration,
+    inextensibility_between_substeps, smallest_binormal_denominators_in_lanes, Integration,
 };
 use crate::rod::twist::{
     hair_optimised_twist_with_angles, newton_twist_in_lanes, ClampedFrames, NewtonSettings,
@@ -171,16 +171,20 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
             strand: alone,
             ..
         } = &mut *self.scratch;
+        // The sharpest folds of all the lanes at once (a plan that does not ask for its
+        // lane's wastes a few packed operations).
+        let smallest = if self.lanes && has_frames {
+            smallest_binormal_denominators_in_lanes(lane_frames, &block.rest.rest_length)
+        } else {
+            [2.0; W]
+        };
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
             let index = first_strand + lane as u32;
             let started = match (self.lanes, has_frames.then_some(&mut alone.frames)) {
                 (true, Some(scratch)) if self.gathered[lane] => {
-                    let (frames, rest_length) = (&*lane_frames, &block.rest.rest_length);
                     let starting = Starting {
                         has_frames: true,
-                        smallest_denominator: |_: &Strand<N>| {
-                            smallest_binormal_denominator_in_lane(frames, rest_length, lane)
-                        },
+                        smallest_denominator: |_: &Strand<N>| smallest[lane],
                         clamped_frames: |s: &Strand<N>, clamped: &ClampedSegments| {
                             scratch.refresh(s);
                             Some(ClampedFrames::save(scratch, &s.state.theta, clamped))

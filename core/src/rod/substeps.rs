@@ -68,9 +68,10 @@ use super::frames::RodFrames;
 use crate::context::{Gates, StepContext};
 use crate::effects::{Effect, Effects};
 use crate::error::ParamError;
-use crate::lane::{Lanes, Wide};
+use crate::lane::{Lane, Lanes, Wide};
 use crate::math::{Math, Real};
 use crate::params::{Mode, Params, Solver};
+use crate::precision::Kernel;
 use crate::strand::{RodRest, Schedule, Strand};
 
 pub use crate::capacities::MAX_SUBSTEPS;
@@ -186,36 +187,35 @@ pub fn smallest_binormal_denominator<M: Math, const N: usize>(
     frames: &RodFrames<M, N>,
     rest_length: &[Real; N],
 ) -> Real {
-    let n = frames.interior();
-    smallest_relative_denominator::<N>(n, |i| frames.denominator[i], |i| rest_length[i])
+    smallest_relative_denominator(frames, rest_length)
 }
 
-/// [`smallest_binormal_denominator`] of lane `lane` of the frames of `W` strands in lanes.
+/// [`smallest_binormal_denominator`] of each lane of the frames of `W` strands in lanes, at
+/// once: lane `l` gets the bits its strand gets alone.
 #[must_use]
-pub fn smallest_binormal_denominator_in_lane<M: Math, const N: usize, const W: usize>(
+pub fn smallest_binormal_denominators_in_lanes<M: Math, const N: usize, const W: usize>(
     frames: &RodFrames<Lanes<M, W>, N>,
     rest_length: &[Wide<W>; N],
-    lane: usize,
-) -> Real {
-    let n = frames.interior();
-    let denominator = |i: usize| frames.denominator[i].0[lane];
-    smallest_relative_denominator::<N>(n, denominator, |i| rest_length[i].0[lane])
+) -> [Real; W] {
+    smallest_relative_denominator(frames, rest_length).0
 }
 
-/// `min d_i / (|ê^{i−1}||ê^i|)` over nodes `1 ..= n` (NaN when any is NaN), 2 when none.
-fn smallest_relative_denominator<const N: usize>(
-    n: usize,
-    denominator: impl Fn(usize) -> Real,
-    rest_length: impl Fn(usize) -> Real,
-) -> Real {
-    let mut smallest: Real = 2.0;
-    for i in 1..=n.min(N.saturating_sub(1)) {
-        let scale = rest_length(i - 1) * rest_length(i);
-        let relative = denominator(i) / scale;
+/// `min d_i / (|ê^{i−1}||ê^i|)` over the interior nodes (NaN when any is NaN), 2 when none.
+#[inline(always)]
+fn smallest_relative_denominator<P: Kernel, const N: usize>(
+    frames: &RodFrames<P, N>,
+    rest_length: &[P::R; N],
+) -> P::R
+where
+    P::R: Lane,
+{
+    let mut smallest = P::R::splat(2.0);
+    for i in 1..=frames.interior().min(N.saturating_sub(1)) {
+        let scale = rest_length[i - 1] * rest_length[i];
+        let relative = frames.denominator[i] / scale;
         // A NaN counts as a fold (the guard rolls the strand back after the step).
-        if relative < smallest || relative.is_nan() {
-            smallest = relative;
-        }
+        let take = relative.lt(smallest) | relative.is_nan();
+        smallest = P::R::select(take, relative, smallest);
     }
     smallest
 }
