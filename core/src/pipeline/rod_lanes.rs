@@ -18,7 +18,9 @@ use crate::forces::{drag, External};
 use crate::grab::Grab;
 use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
-use crate::projection::lanes::{fits_lanes, project_alone, project_strand, BlockProjection};
+use crate::projection::lanes::{
+    fits_lanes, project_alone, project_strand, BlockProjection, LaneEnding,
+};
 use crate::report::{Stage, StepReport};
 use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
@@ -52,8 +54,9 @@ pub struct RodBlockScratch<M: Math, const N: usize, const W: usize> {
     lane_frames: RodFrames<Lanes<M, W>, N>,
     /// One strand's frames and projection.
     strand: RodScratch<M, N>,
-    /// The projection's lanes.
+    /// The projection's lanes, and its ending measured in them.
     projection: BlockProjection<N, W>,
+    ending: LaneEnding<N, W>,
 }
 
 impl<M: Math, const N: usize, const W: usize> RodBlockScratch<M, N, W> {
@@ -65,6 +68,7 @@ impl<M: Math, const N: usize, const W: usize> RodBlockScratch<M, N, W> {
             lane_frames: RodFrames::empty(),
             strand: RodScratch::new(),
             projection: BlockProjection::new(),
+            ending: LaneEnding::new(),
         }
     }
 }
@@ -292,8 +296,9 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
             lane_frames,
             strand: alone,
             projection,
+            ending,
         } = &mut *self.scratch;
-        let projections = (projection, &mut alone.projection);
+        let projections = ((projection, ending), &mut alone.projection);
         let at = (grabs, first_strand);
         project(strands, &self.begun, ctx, at, projections, report);
         // The twist in lanes for the strands in them that hold no segment but the root (a
@@ -329,7 +334,7 @@ fn project<M: Math, const N: usize, const W: usize>(
     begun: &[Option<Begun<M, N>>; W],
     ctx: &StepContext,
     (grabs, first_strand): (&[Grab], u32),
-    (lanes, alone): (&mut BlockProjection<N, W>, &mut BlockProjection<N, 1>),
+    ((lanes, ending), alone): ProjectionScratch<'_, N, W>,
     report: &mut StepReport,
 ) {
     if !ctx.gates.projection {
@@ -341,14 +346,15 @@ fn project<M: Math, const N: usize, const W: usize>(
         let fits = |s: &Strand<N>| fits_lanes(s, ctx, grabs, index, nodes);
         begun[lane].is_some() && strands.get(lane).is_some_and(fits)
     });
-    let in_lanes = taken.iter().filter(|&&t| t).count() > 1 && lanes.run::<M>(strands, &taken, ctx);
+    let in_lanes = taken.iter().filter(|&&t| t).count() > 1
+        && lanes.run_with::<M>(strands, &taken, ctx, Some(&mut *ending));
     for (lane, strand) in strands.iter_mut().enumerate().take(W) {
         if begun[lane].is_none() {
             continue;
         }
         // A strand `taken` fits the lanes' kernel: no second `fits_lanes` for it.
         if in_lanes && taken[lane] {
-            lanes.finish::<M>(lane, strand, ctx, report);
+            lanes.finish::<M>(lane, strand, ctx, report, Some(&*ending));
             continue;
         }
         if taken[lane] {
@@ -359,6 +365,12 @@ fn project<M: Math, const N: usize, const W: usize>(
         }
     }
 }
+
+/// The projections' scratch space of a block: its lanes with their ending, and one strand's.
+type ProjectionScratch<'s, const N: usize, const W: usize> = (
+    (&'s mut BlockProjection<N, W>, &'s mut LaneEnding<N, W>),
+    &'s mut BlockProjection<N, 1>,
+);
 
 /// Lines 9 (space) and 10 for the strands `in_lanes` names, in lanes: their new centrelines
 /// and root frames gathered, the lanes' frame pass, the twist by the scene's method, the

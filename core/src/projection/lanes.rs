@@ -89,7 +89,7 @@ pub(crate) fn project_alone<M: Math, const N: usize>(
     report: &mut StepReport,
 ) -> Outcome {
     scratch.run::<M>(core::slice::from_ref(strand), &[true], ctx);
-    scratch.finish::<M>(0, strand, ctx, report)
+    scratch.finish::<M>(0, strand, ctx, report, None)
 }
 
 /// One lane's bookkeeping: what [`super::project_constraints`] keeps for its strand besides
@@ -115,12 +115,8 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     nodes: usize,
     position: [V3<Wide<W>>; N],
     inverse_mass: [Wide<W>; N],
-    /// `|ê^j|` and `ê^j·ê^j` per segment.
-    rest_length: [Wide<W>; N],
+    /// `ê^j·ê^j` per segment.
     rest_squared: [Wide<W>; N],
-    /// The positions the projection started from (`x̃`, the strands keep them until
-    /// [`Self::finish`]).
-    predicted: [V3<Wide<W>>; N],
     /// Row `r` (segment `r + 1`): `C`, the right-hand side after the contacts' elimination,
     /// `∇C` at the segment's second node, and the blocks at its two nodes after it.
     value: [Wide<W>; N],
@@ -133,8 +129,6 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     lower: [Wide<W>; N],
     fresh: [Wide<W>; N],
     step: [V3<Wide<W>>; N],
-    /// What [`Self::conclude`] measured of each lane's projected positions.
-    concluded: Concluded<W>,
     /// Whether the last evaluation took the chain's forward elimination on the way
     /// ([`Self::evaluate_and_eliminate`]); the pivots it dropped are then in `lower[0]`, which
     /// the first row has no use for.
@@ -184,9 +178,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             nodes: 0,
             position: [zero3; N],
             inverse_mass: [zero; N],
-            rest_length: [zero; N],
             rest_squared: [zero; N],
-            predicted: [zero3; N],
             value: [zero; N],
             rhs: [zero; N],
             gradient: [zero3; N],
@@ -195,11 +187,6 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             lower: [zero; N],
             fresh: [zero; N],
             step: [zero3; N],
-            concluded: Concluded {
-                finite: [false; W],
-                free_stretch: [0.0; W],
-                contact_stretch: [0.0; W],
-            },
             chained: false,
             lanes: [const { Lane::EMPTY }; W],
         }
@@ -215,6 +202,18 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         strands: &[Strand<N>],
         taken: &[bool; W],
         ctx: &StepContext,
+    ) -> bool {
+        self.run_with::<M>(strands, taken, ctx, None)
+    }
+
+    /// [`Self::run`], and with `ending`, the ending of every lane measured in lanes
+    /// ([`LaneEnding`]), for [`Self::finish`] to take.
+    pub fn run_with<M: Math>(
+        &mut self,
+        strands: &[Strand<N>],
+        taken: &[bool; W],
+        ctx: &StepContext,
+        mut ending: Option<&mut LaneEnding<N, W>>,
     ) -> bool {
         let Some(lead) = taken.iter().position(|&t| t).and_then(|f| strands.get(f)) else {
             return false;
@@ -242,24 +241,32 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
                 self.position[i].set_lane(l, strand.state.position[i]);
                 self.inverse_mass[i].0[l] = book.nodes.inverse_mass[i];
                 let rest = strand.rest.segment_length[i];
-                self.rest_length[i].0[l] = rest;
                 self.rest_squared[i].0[l] = rest * rest;
+                if let Some(ending) = ending.as_deref_mut() {
+                    ending.rest_length[i].0[l] = rest;
+                }
             }
         }
-        self.predicted[..nodes].copy_from_slice(&self.position[..nodes]);
+        if let Some(ending) = ending.as_deref_mut() {
+            ending.predicted[..nodes].copy_from_slice(&self.position[..nodes]);
+        }
         self.iterate::<M>(strands, ctx, shapes, layout);
-        self.conclude::<M>(ctx.inv_dt);
+        if let Some(ending) = ending {
+            ending.measure::<M>(self, ctx.inv_dt);
+        }
         true
     }
 
     /// Lane `lane`'s strand takes its projected positions, keeps them finite, updates its
-    /// velocities and reports, as [`super::project_constraints`] ends.
+    /// velocities and reports, as [`super::project_constraints`] ends: with what `ending`
+    /// measured in the lanes when [`Self::run_with`] took it, else strand by strand.
     pub fn finish<M: Math>(
         &self,
         lane: usize,
         strand: &mut Strand<N>,
         ctx: &StepContext,
         report: &mut StepReport,
+        ending: Option<&LaneEnding<N, W>>,
     ) -> Outcome {
         let Some(book) = self.lanes.get(lane).filter(|_| self.taken[lane]) else {
             return Outcome::default();
@@ -275,16 +282,17 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             truncated: book.truncated,
             collider_push: &book.collider_push,
         };
-        if !self.concluded.finite[lane] {
-            // An overflow on absurd input (rare): the strand's own ending, which keeps the
-            // positions it came in with.
+        let Some(concluded) = ending.map(|e| &e.concluded).filter(|c| c.finite[lane]) else {
+            // Measured strand by strand (one strand alone), or an overflow on absurd input
+            // (rare): the strand's own ending, which keeps the positions it came in with if
+            // need be.
             let predicted = strand.state.position;
             for (x, lanes) in strand.state.position.iter_mut().zip(&self.position).take(n) {
                 *x = lanes.lane(lane);
             }
             return conclude::<M, N>(strand, &predicted, ctx, book.outcome, findings, report);
-        }
-        // `conclude`, with what `Self::conclude` measured in lanes: the same bits.
+        };
+        // `conclude`, with what `LaneEnding::measure` measured in lanes: the same bits.
         let state = &mut strand.state;
         for (x, lanes) in state.position.iter_mut().zip(&self.position).take(n) {
             *x = lanes.lane(lane);
@@ -294,56 +302,10 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             *v += change.lane(lane);
         }
         record_outcome(ctx, &book.outcome, &findings, n, report);
-        let concluded = &self.concluded;
         report.max_stretch = report.max_stretch.max(concluded.free_stretch[lane]);
         let at_contacts = concluded.contact_stretch[lane];
         report.max_contact_stretch = report.max_contact_stretch.max(at_contacts);
         book.outcome
-    }
-
-    /// The end of [`super::conclude`] that the lanes can share, for every lane at once: the
-    /// velocity change `(x − x̃)/h` of each node (into `step`, which the iterations are done
-    /// with), whether all of a lane's are finite, and the lane's largest stretch away from
-    /// and at contacts (`super::record`'s, by the same operations; a maximum does not depend
-    /// on the order its values come in).
-    fn conclude<M: Math>(&mut self, inv_dt: Real) {
-        let n = self.nodes.min(N);
-        let inv_dt = Wide::splat(inv_dt);
-        let mut finite = <Wide<W> as crate::lane::Lane>::mask(true);
-        for ((change, &x), &predicted) in self
-            .step
-            .iter_mut()
-            .zip(&self.position)
-            .zip(&self.predicted)
-            .take(n)
-        {
-            *change = (x - predicted) * inv_dt;
-            finite = finite & change.finite();
-        }
-        let touched = |l: usize, i: usize| self.lanes[l].contacts.touched[i] != 0;
-        let any_touched = (0..W).any(|l| (0..n).any(|i| touched(l, i)));
-        let zero = Wide::splat(0.0);
-        let (mut free, mut contact) = (zero, zero);
-        for j in 0..n.saturating_sub(1) {
-            let e = self.position[j + 1] - self.position[j];
-            let rest = self.rest_length[j];
-            let length = <Lanes<M, W> as Kernel>::sqrt(e.dot(e));
-            let stretch = (length - rest).abs() / rest;
-            if any_touched {
-                let at_contact = WideMask::from_bools(core::array::from_fn(|l| {
-                    touched(l, j) || touched(l, j + 1)
-                }));
-                contact = contact.max_where(at_contact, stretch);
-                free = free.max_where(!at_contact, stretch);
-            } else {
-                free = free.max(stretch);
-            }
-        }
-        self.concluded = Concluded {
-            finite: finite.to_bools(),
-            free_stretch: free.0,
-            contact_stretch: contact.0,
-        };
     }
 
     /// `super::iterate` in lanes: evaluate, test, solve, move, each lane until it stops.
@@ -847,7 +809,86 @@ fn segment_moves_of<const N: usize, const W: usize>(
     }
 }
 
-/// What [`BlockProjection::conclude`] measured of each lane.
+/// The ending of a block's projection (`super::conclude`) measured in its lanes, for all its
+/// strands at once: what the blocks of the harness keep beside their [`BlockProjection`]. One
+/// strand alone ends strand by strand: at one lane the copies cost more than they save, and
+/// the world's scratch space (`RodScratch`, inside `hairsim_init`'s buffer) would grow by
+/// `|ê|`, `x̃` and the findings for nothing.
+pub struct LaneEnding<const N: usize, const W: usize> {
+    /// `|ê^j|` per segment.
+    rest_length: [Wide<W>; N],
+    /// The positions the projection started from (`x̃`; the strands keep them until
+    /// [`BlockProjection::finish`]).
+    predicted: [V3<Wide<W>>; N],
+    /// What [`Self::measure`] found.
+    concluded: Concluded<W>,
+}
+
+impl<const N: usize, const W: usize> LaneEnding<N, W> {
+    /// Before its first use.
+    #[must_use]
+    pub const fn new() -> Self {
+        LaneEnding {
+            rest_length: [Wide([0.0; W]); N],
+            predicted: [<V3<Wide<W>> as Vector<Wide<W>>>::ZERO; N],
+            concluded: Concluded {
+                finite: [false; W],
+                free_stretch: [0.0; W],
+                contact_stretch: [0.0; W],
+            },
+        }
+    }
+
+    /// The end of [`super::conclude`] that the lanes can share, for every lane of
+    /// `projection` at once: the velocity change `(x − x̃)/h` of each node (into its `step`,
+    /// which the iterations are done with), whether all of a lane's are finite, and the
+    /// lane's largest stretch away from and at contacts (`super::record`'s, by the same
+    /// operations; a maximum does not depend on the order its values come in).
+    fn measure<M: Math>(&mut self, projection: &mut BlockProjection<N, W>, inv_dt: Real) {
+        let n = projection.nodes.min(N);
+        let inv_dt = Wide::splat(inv_dt);
+        let mut finite = <Wide<W> as crate::lane::Lane>::mask(true);
+        let (position, step) = (&projection.position, &mut projection.step);
+        for ((change, &x), &predicted) in step.iter_mut().zip(position).zip(&self.predicted).take(n)
+        {
+            *change = (x - predicted) * inv_dt;
+            finite = finite & change.finite();
+        }
+        let lanes = &projection.lanes;
+        let touched = |l: usize, i: usize| lanes[l].contacts.touched[i] != 0;
+        let any_touched = (0..W).any(|l| (0..n).any(|i| touched(l, i)));
+        let zero = Wide::splat(0.0);
+        let (mut free, mut contact) = (zero, zero);
+        for j in 0..n.saturating_sub(1) {
+            let e = position[j + 1] - position[j];
+            let rest = self.rest_length[j];
+            let length = <Lanes<M, W> as Kernel>::sqrt(e.dot(e));
+            let stretch = (length - rest).abs() / rest;
+            if any_touched {
+                let at_contact = WideMask::from_bools(core::array::from_fn(|l| {
+                    touched(l, j) || touched(l, j + 1)
+                }));
+                contact = contact.max_where(at_contact, stretch);
+                free = free.max_where(!at_contact, stretch);
+            } else {
+                free = free.max(stretch);
+            }
+        }
+        self.concluded = Concluded {
+            finite: finite.to_bools(),
+            free_stretch: free.0,
+            contact_stretch: contact.0,
+        };
+    }
+}
+
+impl<const N: usize, const W: usize> Default for LaneEnding<N, W> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// What [`LaneEnding::measure`] measured of each lane.
 #[derive(Clone, Copy)]
 struct Concluded<const W: usize> {
     /// Whether every node's velocity change is finite.
