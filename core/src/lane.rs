@@ -321,8 +321,9 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     }
     #[inline(always)]
     fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {
-        // A plain loop, not `array::from_fn`: the compiler once left the closure out of line
-        // in the twist's sweep, and the host's rod blocks stepped 5 % slower for it.
+        // Lane by lane: written over the lanes with selects (the same bits), it made Head #1's
+        // blocks 5 % slower. A plain loop, not `array::from_fn`: the compiler once left the
+        // closure out of line in the twist's sweep, and the blocks stepped 5 % slower for it.
         let mut angle = [0.0; W];
         for ((angle, &y), &x) in angle.iter_mut().zip(&y.0).zip(&x.0) {
             *angle = M::atan2(y, x);
@@ -756,8 +757,7 @@ pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
 }
 
 /// [`crate::precision::Scalar::floor_and_parity`] of each lane, with its bits: the integer
-/// work in lanes (the truncation, the step down, the parity as a mask). (`atan2` stays lane
-/// by lane: written over the lanes with selects, it made Head #1's blocks 5 % slower.)
+/// work in lanes (the truncation, the step down, the parity as a mask).
 #[inline(always)]
 #[must_use]
 pub fn floor_and_parity_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, WideMask<W>) {

@@ -20,10 +20,10 @@ use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Grab};
-use crate::lane::{Lane as _, Lanes, Wide, WideMask, V3};
+use crate::lane::{Lane as _, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
-use crate::precision::{Kernel, Vector};
+use crate::precision::Vector;
 use crate::report::{Stage, StepReport};
 use crate::strand::Strand;
 
@@ -33,7 +33,8 @@ use super::constraints::{
 };
 use super::{
     conclude, free_nodes, layout_of, project_constraints, prune_tentative, push_on_colliders,
-    record_outcome, trust_radius, trust_scale, usable_colliders, Findings, NearColliders, Outcome,
+    record_outcome, segment_stretch, trust_radius, trust_scale, usable_colliders, Findings,
+    NearColliders, Outcome,
 };
 
 /// Whether strand `strand` (index `index` in the scene) can be projected in lanes with
@@ -847,7 +848,7 @@ impl<const N: usize, const W: usize> LaneEnding<N, W> {
     fn measure<M: Math>(&mut self, projection: &mut BlockProjection<N, W>, inv_dt: Real) {
         let n = projection.nodes.min(N);
         let inv_dt = Wide::splat(inv_dt);
-        let mut finite = <Wide<W> as crate::lane::Lane>::mask(true);
+        let mut finite = WideMask::from_bools([true; W]);
         let (position, step) = (&projection.position, &mut projection.step);
         for ((change, &x), &predicted) in step.iter_mut().zip(position).zip(&self.predicted).take(n)
         {
@@ -861,9 +862,7 @@ impl<const N: usize, const W: usize> LaneEnding<N, W> {
         let (mut free, mut contact) = (zero, zero);
         for j in 0..n.saturating_sub(1) {
             let e = position[j + 1] - position[j];
-            let rest = self.rest_length[j];
-            let length = <Lanes<M, W> as Kernel>::sqrt(e.dot(e));
-            let stretch = (length - rest).abs() / rest;
+            let stretch = segment_stretch::<M, Wide<W>>(e, self.rest_length[j]);
             if any_touched {
                 let at_contact = WideMask::from_bools(core::array::from_fn(|l| {
                     touched(l, j) || touched(l, j + 1)

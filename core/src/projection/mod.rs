@@ -39,6 +39,7 @@ use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Grab, GrabbedNodes, MAX_GRABS};
+use crate::lane::{Lane, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
 use crate::report::{Flags, Stage, StepReport};
@@ -845,14 +846,20 @@ fn record<M: Math, const N: usize>(
     let x = &strand.state.position;
     for j in 0..n.saturating_sub(1) {
         let rest = strand.rest.segment_length[j];
-        let e = x[j + 1] - x[j];
-        let stretch = (M::length(e) - rest).abs() / rest;
+        let stretch = segment_stretch::<M, Real>((x[j + 1] - x[j]).into(), rest);
         if work.touched[j] != 0 || work.touched[j + 1] != 0 {
             report.max_contact_stretch = report.max_contact_stretch.max(stretch);
         } else {
             report.max_stretch = report.max_stretch.max(stretch);
         }
     }
+}
+
+/// `||e| − |ê|| / |ê|`: the stretch of a segment `e` of rest length `|ê|` = `rest`, for one
+/// strand or for lanes of them (`lanes::LaneEnding`), by the same operations.
+#[inline(always)]
+fn segment_stretch<M: Math, T: Lane>(e: V3<T>, rest: T) -> T {
+    (e.dot(e).sqrt::<M>() - rest).abs() / rest
 }
 
 /// [`record`] but the stretch, of a strand of `n` nodes: iterations, residual, flags,
