@@ -312,7 +312,7 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     const FRAC_1_PI: Wide<W> = Wide([core::f32::consts::FRAC_1_PI; W]);
     #[inline(always)]
     fn sin_cos(x: Wide<W>) -> (Wide<W>, Wide<W>) {
-        if M::PLAIN_SIN_COS {
+        if M::PLAIN_TRIGONOMETRY {
             sin_cos_in_lanes(x)
         } else {
             let both = x.0.map(M::sin_cos);
@@ -321,14 +321,15 @@ impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     }
     #[inline(always)]
     fn atan2(y: Wide<W>, x: Wide<W>) -> Wide<W> {
-        // Lane by lane: written over the lanes with selects (the same bits), it made Head #1's
-        // blocks 5 % slower. A plain loop, not `array::from_fn`: the compiler once left the
-        // closure out of line in the twist's sweep, and the blocks stepped 5 % slower for it.
-        let mut angle = [0.0; W];
-        for ((angle, &y), &x) in angle.iter_mut().zip(&y.0).zip(&x.0) {
-            *angle = M::atan2(y, x);
+        if M::PLAIN_TRIGONOMETRY {
+            atan2_in_lanes(y, x)
+        } else {
+            let mut angle = [0.0; W];
+            for ((angle, &y), &x) in angle.iter_mut().zip(&y.0).zip(&x.0) {
+                *angle = M::atan2(y, x);
+            }
+            Wide(angle)
         }
-        Wide(angle)
     }
     #[inline(always)]
     fn floor_and_parity(x: Wide<W>) -> (Wide<W>, WideMask<W>) {
@@ -756,25 +757,101 @@ pub fn sin_cos_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, Wide<W>) {
     (Wide(sin_out), Wide(cos_out))
 }
 
-/// [`crate::precision::Scalar::floor_and_parity`] of each lane, with its bits: the integer
-/// work in lanes (the truncation, the step down, the parity as a mask).
+/// [`crate::math::atan2`] of each lane, with the bits it gives that lane: its branches as
+/// selects of whole lanes, its one division packed.
+#[inline(always)]
+#[must_use]
+pub fn atan2_in_lanes<const W: usize>(y: Wide<W>, x: Wide<W>) -> Wide<W> {
+    let (ax, ay) = (x.abs(), y.abs());
+    let steep = Lane::lt(ax, ay);
+    let numerator = Lane::select(steep, ax, ay);
+    let denominator = Lane::select(steep, ay, ax);
+    let flat = WideMask(lane_pairs(denominator.0, denominator.0, |d, _| {
+        lane_mask(d == 0.0)
+    }));
+    let t = Lane::select(flat, Wide::splat(0.0), numerator / denominator);
+    // Each coefficient splat by itself: an array `map` is sometimes left out of line.
+    let a = |k: usize| Wide::splat(math::ATAN_COEFFICIENTS[k]);
+    let u = t * t;
+    let u2 = u * u;
+    let pairs = [
+        a(0) + a(1) * u,
+        a(2) + a(3) * u,
+        a(4) + a(5) * u,
+        a(6) + a(7) * u,
+    ];
+    let u4 = u2 * u2;
+    let quads = [pairs[0] + pairs[1] * u2, pairs[2] + pairs[3] * u2];
+    let p = (quads[0] + quads[1] * u4) + a(8) * (u4 * u4);
+    let mut angle = t * p;
+    angle = Lane::select(
+        steep,
+        Wide::splat(core::f32::consts::FRAC_PI_2) - angle,
+        angle,
+    );
+    angle = Lane::select(
+        sign_mask(x),
+        Wide::splat(core::f32::consts::PI) - angle,
+        angle,
+    );
+    Lane::select(sign_mask(y), -angle, angle)
+}
+
+/// Whether each lane's sign bit is set (`is_sign_negative`), as a whole-lane mask.
+#[inline(always)]
+fn sign_mask<const W: usize>(x: Wide<W>) -> WideMask<W> {
+    WideMask(lane_pairs(x.0, x.0, |x, _| {
+        ((x.to_bits() as i32) >> 31) as u32
+    }))
+}
+
+/// [`crate::precision::Scalar::floor_and_parity`] of each lane, with its bits: the floor and
+/// its parity in packed float and bit operations where `|x| < 2^22`, the scalar function in
+/// the other lanes. The scalar's `as i32` and back, four times, was what the compiler most
+/// often left unpacked in the twist's sweep.
 #[inline(always)]
 #[must_use]
 pub fn floor_and_parity_in_lanes<const W: usize>(x: Wide<W>) -> (Wide<W>, WideMask<W>) {
-    let mut k = [0_i32; W];
-    for (k, x) in k.iter_mut().zip(x.0) {
-        let truncated = x as i32;
-        // `saturating_sub(1)`: the step down never passes `i32::MIN`.
-        let down = truncated as Real > x && truncated != i32::MIN;
-        *k = truncated - i32::from(down);
+    // `|x| < 2^22`: the floor in floats, exact; NaN and larger lanes as the scalar takes them
+    // (`as` saturates), one by one.
+    let rounded = rounded_small(x);
+    let above = Lane::lt(x, rounded);
+    let mut floor = Lane::select(above, rounded - Wide::splat(1.0), rounded);
+    let mut odd = odd_mask(floor);
+    let large = lane_pairs(x.0, x.0, |x, _| x.is_nan() || x.abs() >= SMALL_INTEGERS);
+    if large.contains(&true) {
+        for l in (0..W).filter(|&l| large[l]) {
+            let (f, o) = crate::precision::Scalar::floor_and_parity(x.0[l]);
+            floor.0[l] = f;
+            odd.set(l, o);
+        }
     }
-    let mut floor = [0.0; W];
-    let mut odd = [0_u32; W];
-    for ((floor, odd), k) in floor.iter_mut().zip(&mut odd).zip(k) {
-        *floor = k as Real;
-        *odd = lane_mask(k & 1 != 0);
-    }
-    (Wide(floor), WideMask(odd))
+    (floor, odd)
+}
+
+/// Below this magnitude, adding and subtracting [`ROUNDING`] rounds a float to an integer
+/// exactly, and the integer sits in the low bits of the sum's mantissa.
+const SMALL_INTEGERS: Real = 4_194_304.0; // 2^22
+/// `1.5 · 2^23`: `x + ROUNDING` lies in `[2^23, 2^24)`, where the spacing of floats is 1, for
+/// every `|x| < 2^22`; its mantissa is `x + 2^22`, rounded to the nearest integer (ties to
+/// even).
+const ROUNDING: Real = 12_582_912.0;
+
+/// `x` rounded to the nearest integer, ties to even, for `|x| < 2^22` (other lanes: any
+/// value): two packed additions.
+#[inline(always)]
+fn rounded_small<const W: usize>(x: Wide<W>) -> Wide<W> {
+    (x + Wide::splat(ROUNDING)) - Wide::splat(ROUNDING)
+}
+
+/// Whether the integer `k` (`|k| < 2^22`) is odd: `k + 1.5 · 2^23`'s mantissa is
+/// `k + 2^22`, whose lowest bit is `k`'s.
+#[inline(always)]
+fn odd_mask<const W: usize>(k: Wide<W>) -> WideMask<W> {
+    let biased = k + Wide::splat(ROUNDING);
+    WideMask(lane_pairs(biased.0, biased.0, |b, _| {
+        lane_mask(b.to_bits() & 1 != 0)
+    }))
 }
 
 #[cfg(test)]
@@ -812,6 +889,41 @@ mod tests {
     }
 
     #[test]
+    fn atan2_in_lanes_gives_each_lane_the_bits_of_atan2() {
+        let specials = [
+            0.0,
+            -0.0,
+            Real::NAN,
+            Real::INFINITY,
+            -Real::INFINITY,
+            Real::MIN_POSITIVE,
+            -1.0e-40,
+            3.0e38,
+        ];
+        let mut checked = 0;
+        for k in 0..40_000u32 {
+            let a = (k as Real - 20_000.0) * 0.000_37;
+            let b = (k as Real * 0.618_034).sin() * 2.0;
+            let special = specials[k as usize % specials.len()];
+            let ys = [a, -b, special, b * 1.0e-3];
+            let xs = [b, a, a, specials[(k as usize / 8) % specials.len()]];
+            let angles = atan2_in_lanes(Wide(ys), Wide(xs));
+            for l in 0..4 {
+                let expected = math::atan2(ys[l], xs[l]);
+                assert_eq!(
+                    angles.0[l].to_bits(),
+                    expected.to_bits(),
+                    "{} {}",
+                    ys[l],
+                    xs[l]
+                );
+                checked += 1;
+            }
+        }
+        assert_eq!(checked, 160_000);
+    }
+
+    #[test]
     fn floor_and_parity_in_lanes_gives_each_lane_the_scalar_bits() {
         let specials = [
             Real::NAN,
@@ -820,6 +932,10 @@ mod tests {
             -3.0e9,
             3.0e9,
             -0.0,
+            4_194_303.5,
+            -4_194_303.5,
+            4_194_304.0,
+            -4_194_305.0,
         ];
         for k in 0..20_000u32 {
             let x = (k as Real - 10_000.0) * 0.013_7;

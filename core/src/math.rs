@@ -33,10 +33,11 @@ pub trait Math: Copy + Default + 'static {
     /// Four-quadrant arctangent of `y / x`.
     fn atan2(y: Real, x: Real) -> Real;
 
-    /// Whether `sin_cos` is this module's [`sin_cos`] (plain `f32` arithmetic): then the
-    /// lanes take it in their own form (`lane::sin_cos_in_lanes`, the same bits per lane),
-    /// which the compiler packs; otherwise lane by lane. Say `true` only for that function.
-    const PLAIN_SIN_COS: bool = false;
+    /// Whether `sin_cos` and `atan2` are this module's [`sin_cos`] and [`atan2`] (plain `f32`
+    /// arithmetic): then the lanes take them in their own form (`lane::sin_cos_in_lanes`,
+    /// `lane::atan2_in_lanes`, the same bits per lane), which the compiler packs; otherwise
+    /// lane by lane. Say `true` only for those two functions.
+    const PLAIN_TRIGONOMETRY: bool = false;
 
     /// Euclidean length of `v`, summed as `x² + y² + z²` left to right.
     #[inline(always)]
@@ -54,7 +55,7 @@ pub struct Libm;
 
 impl Math for Libm {
     const NAME: &'static str = "libm";
-    const PLAIN_SIN_COS: bool = true;
+    const PLAIN_TRIGONOMETRY: bool = true;
     #[inline(always)]
     fn sqrt(x: Real) -> Real {
         libm::sqrtf(x)
@@ -185,7 +186,7 @@ pub fn sin_cos(x: Real) -> (Real, Real) {
 
 /// `atan(t) / t = Σ a_k u^k` with `u = t² ∈ [0, 1]`, lowest power first: a Chebyshev fit of
 /// degree 8, rounded to f32 (in f32 its error is about 1e-7 rad for `t ∈ [0, 1]`).
-const ATAN_COEFFICIENTS: [Real; 9] = [
+pub(crate) const ATAN_COEFFICIENTS: [Real; 9] = [
     1.0,
     -0.333_330_36,
     0.199_918_72,

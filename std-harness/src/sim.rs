@@ -41,7 +41,7 @@ pub struct VectorSqrt<M>(std::marker::PhantomData<M>);
 
 impl<M: Math> Math for VectorSqrt<M> {
     const NAME: &'static str = M::NAME;
-    const PLAIN_SIN_COS: bool = M::PLAIN_SIN_COS;
+    const PLAIN_TRIGONOMETRY: bool = M::PLAIN_TRIGONOMETRY;
     #[inline(always)]
     fn sqrt(x: Real) -> Real {
         x.sqrt()

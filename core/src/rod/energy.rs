@@ -226,6 +226,7 @@ pub fn elastic_forces<P: Precision, const N: usize>(
 
 /// [`elastic_forces`] with `(cos θ^j, sin θ^j)` already computed (substeps at fixed `θ` share
 /// them), on one strand or on `W` in lanes (`lane::Lanes`, `clamped` then one set per lane).
+#[inline(never)]
 pub fn elastic_forces_with_angles<P: Kernel, C: ClampedLanes<P::R>, const N: usize>(
     frames: &RodFrames<P, N>,
     theta: &[P::R],

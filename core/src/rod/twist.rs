@@ -143,13 +143,16 @@ impl<R: Arithmetic> TwistWeights<R> {
     ) -> Self {
         let beta = twist_stiffness(rest, terms);
         let interior = |i: usize| i >= 1 && i <= n;
-        let weight = [j, j + 1].map(|i| {
+        // Written out, not `[j, j + 1].map(..)`: the compiler left that map out of line in
+        // the lanes' sweep (1.6 % of a block's step).
+        let weight_at = |i: usize| {
             if interior(i) {
                 beta * rest.inverse_voronoi_length[i]
             } else {
                 R::ZERO
             }
-        });
+        };
+        let weight = [weight_at(j), weight_at(j + 1)];
         let next = if interior(j + 1) {
             theta[j + 1] - rest.rest_twist[j + 1]
         } else {
@@ -318,7 +321,10 @@ fn lower_of<R: Arithmetic>(some: R::Mask, candidate: Choice<R>, best: Choice<R>)
     let lower = some & candidate.energy.lt(best.energy);
     let blend = |m, a: Choice<R>, b: Choice<R>| Choice {
         angle: R::select(m, a.angle, b.angle),
-        cos_sin: [0, 1].map(|k| R::select(m, a.cos_sin[k], b.cos_sin[k])),
+        cos_sin: [
+            R::select(m, a.cos_sin[0], b.cos_sin[0]),
+            R::select(m, a.cos_sin[1], b.cos_sin[1]),
+        ],
         energy: R::select(m, a.energy, b.energy),
     };
     select_whole::<R, _>(lower, candidate, best, blend)
