@@ -204,9 +204,9 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
 #[must_use]
 pub fn read_lanes<const W: usize>(v: &VecLanes<W>) -> V3<Wide<W>> {
     V3 {
-        x: Wide(v[0]),
-        y: Wide(v[1]),
-        z: Wide(v[2]),
+        x: Wide::new(v[0]),
+        y: Wide::new(v[1]),
+        z: Wide::new(v[2]),
     }
 }
 
@@ -236,12 +236,12 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
             velocity: read_lanes(&state.velocity),
             extra,
             has_extra,
-            mass: Wide(*self.mass.get(k)?),
+            mass: Wide::new(*self.mass.get(k)?),
             rest_position: read_lanes(&shape.rest_position),
             local_rest: read_lanes(&shape.local_rest),
-            root_distance: Wide(shape.root_distance),
-            segment_length: Wide(rest.segment_length),
-            strain_scale: Wide(rest.strain_scale),
+            root_distance: Wide::new(shape.root_distance),
+            segment_length: Wide::new(rest.segment_length),
+            strain_scale: Wide::new(rest.strain_scale),
         })
     }
 

@@ -408,7 +408,7 @@ fn block_pass<
         return velocity_total;
     }
     let nodes = block.nodes;
-    let nodes_real = Wide(core::array::from_fn(|l| nodes[l] as Real));
+    let nodes_real = Wide::new(core::array::from_fn(|l| nodes[l] as Real));
     // The chain at node 1: `R_head R̂_0`, all lanes at once.
     let (tangent, normal) = (
         read_lanes(&block.root_tangent),

@@ -21,6 +21,7 @@ use crate::context::StepContext;
 use crate::forces::External;
 use crate::grab::Grab;
 use crate::guard::{guard, sound};
+use crate::lane::Natural;
 use crate::math::{unit, Math, Real, Vec3};
 use crate::projection::lanes::{project_strand, BlockProjection};
 use crate::projection::project_constraints;
@@ -88,7 +89,7 @@ pub fn step_strand<M: Math, const N: usize>(
 /// the Cortex-M4F's rod step (`firmware/profile.py`).
 pub struct RodScratch<M: Math, const N: usize> {
     pub(super) frames: RodFrames<M, N>,
-    pub(super) projection: BlockProjection<N, 1>,
+    pub(super) projection: BlockProjection<N, 1, Natural>,
 }
 
 impl<M: Math, const N: usize> RodScratch<M, N> {
@@ -231,7 +232,7 @@ pub(super) fn integrate<M: Math, const N: usize>(
 pub(super) fn finish<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1>),
+    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1, Natural>),
     begun: &Begun<M, N>,
     frames: Option<&mut RodFrames<M, N>>,
     angles: &[[Real; 2]; N],
@@ -248,7 +249,7 @@ pub(super) fn finish<M: Math, const N: usize>(
 pub(super) fn constrain<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1>),
+    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1, Natural>),
     begun: &Begun<M, N>,
     report: &mut StepReport,
 ) {

@@ -16,7 +16,7 @@
 use crate::context::StepContext;
 use crate::forces::{drag, External};
 use crate::grab::Grab;
-use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
+use crate::lane::{Lane, Lanes, Natural, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::projection::lanes::{
     fits_lanes, project_alone, project_strand, BlockProjection, LaneEnding,
@@ -369,7 +369,7 @@ fn project<M: Math, const N: usize, const W: usize>(
 /// The projections' scratch space of a block: its lanes with their ending, and one strand's.
 type ProjectionScratch<'s, const N: usize, const W: usize> = (
     (&'s mut BlockProjection<N, W>, &'s mut LaneEnding<N, W>),
-    &'s mut BlockProjection<N, 1>,
+    &'s mut BlockProjection<N, 1, Natural>,
 );
 
 /// Lines 9 (space) and 10 for the strands `in_lanes` names, in lanes: their new centrelines
@@ -500,7 +500,7 @@ fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
     report.ran_on(Stage::ExternalForces, lanes);
     report.ran_on(Stage::Integrate, lanes);
     let most = substeps.iter().copied().max().unwrap_or(0);
-    let h = Wide(substeps.map(|k| ctx.dt / k.max(1) as Real));
+    let h = Wide::new(substeps.map(|k| ctx.dt / k.max(1) as Real));
     let terms = ElasticTerms::of(&ctx.gates);
     let external = External::<Lanes<M, W>> {
         gravity_and_wind: V3::splat(ctx.gravity + ctx.wind),

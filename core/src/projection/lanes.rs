@@ -20,7 +20,7 @@ use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Grab};
-use crate::lane::{Lane as _, Wide, WideMask, V3};
+use crate::lane::{Aligned, Alignment, Lane as _, Natural, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
 use crate::precision::Vector;
@@ -66,7 +66,7 @@ pub fn project_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     (grabs, strand_index): (&[Grab], u32),
-    scratch: &mut BlockProjection<N, 1>,
+    scratch: &mut BlockProjection<N, 1, Natural>,
     report: &mut StepReport,
 ) -> Outcome {
     let nodes = strand.rest.nodes.min(N);
@@ -86,7 +86,7 @@ pub fn project_strand<M: Math, const N: usize>(
 pub(crate) fn project_alone<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    scratch: &mut BlockProjection<N, 1>,
+    scratch: &mut BlockProjection<N, 1, Natural>,
     report: &mut StepReport,
 ) -> Outcome {
     scratch.run::<M>(core::slice::from_ref(strand), &[true], ctx);
@@ -111,25 +111,25 @@ struct Lane<const N: usize> {
 
 /// The projection of up to `W` strands in lanes: run by [`BlockProjection::run`], then each
 /// strand's result taken in scene order by [`BlockProjection::finish`].
-pub struct BlockProjection<const N: usize, const W: usize> {
+pub struct BlockProjection<const N: usize, const W: usize, A: Alignment = Aligned> {
     taken: [bool; W],
     nodes: usize,
-    position: [V3<Wide<W>>; N],
-    inverse_mass: [Wide<W>; N],
+    position: [V3<Wide<W, A>>; N],
+    inverse_mass: [Wide<W, A>; N],
     /// `ê^j·ê^j` per segment.
-    rest_squared: [Wide<W>; N],
+    rest_squared: [Wide<W, A>; N],
     /// Row `r` (segment `r + 1`): `C`, the right-hand side after the contacts' elimination,
     /// `∇C` at the segment's second node, and the blocks at its two nodes after it.
-    value: [Wide<W>; N],
-    rhs: [Wide<W>; N],
-    gradient: [V3<Wide<W>>; N],
-    projected: [[V3<Wide<W>>; 2]; N],
-    multipliers: [Wide<W>; N],
+    value: [Wide<W, A>; N],
+    rhs: [Wide<W, A>; N],
+    gradient: [V3<Wide<W, A>>; N],
+    projected: [[V3<Wide<W, A>>; 2]; N],
+    multipliers: [Wide<W, A>; N],
     /// The chain's factor `L` below the diagonal and its solution in the making
     /// (`solve_chain`): written before they are read, kept here so that no solve zeroes them.
-    lower: [Wide<W>; N],
-    fresh: [Wide<W>; N],
-    step: [V3<Wide<W>>; N],
+    lower: [Wide<W, A>; N],
+    fresh: [Wide<W, A>; N],
+    step: [V3<Wide<W, A>>; N],
     /// Whether the last evaluation took the chain's forward elimination on the way
     /// ([`Self::evaluate_and_eliminate`]); the pivots it dropped are then in `lower[0]`, which
     /// the first row has no use for.
@@ -137,7 +137,7 @@ pub struct BlockProjection<const N: usize, const W: usize> {
     lanes: [Lane<N>; W],
 }
 
-impl<const N: usize, const W: usize> Default for BlockProjection<N, W> {
+impl<const N: usize, const W: usize, A: Alignment> Default for BlockProjection<N, W, A> {
     fn default() -> Self {
         Self::new()
     }
@@ -167,13 +167,13 @@ impl<const N: usize> Lane<N> {
     };
 }
 
-impl<const N: usize, const W: usize> BlockProjection<N, W> {
+impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
     /// A scratch space before its first use (`const`: a world keeps one, built at compile
     /// time, so that no step fills one).
     #[must_use]
     pub const fn new() -> Self {
-        let zero = Wide([0.0; W]);
-        let zero3 = <V3<Wide<W>> as Vector<Wide<W>>>::ZERO;
+        let zero = Wide::new([0.0; W]);
+        let zero3 = <V3<Wide<W, A>> as Vector<Wide<W, A>>>::ZERO;
         BlockProjection {
             taken: [false; W],
             nodes: 0,
@@ -194,7 +194,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     }
 }
 
-impl<const N: usize, const W: usize> BlockProjection<N, W> {
+impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
     /// Projects the strands `taken` names (each [`fits_lanes`]) in lanes, in this scratch
     /// space (made once for many blocks: it is large); `false` if it names none. The strands
     /// keep their positions until [`Self::finish`].
@@ -214,7 +214,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         strands: &[Strand<N>],
         taken: &[bool; W],
         ctx: &StepContext,
-        mut ending: Option<&mut LaneEnding<N, W>>,
+        mut ending: Option<&mut LaneEnding<N, W, A>>,
     ) -> bool {
         let Some(lead) = taken.iter().position(|&t| t).and_then(|f| strands.get(f)) else {
             return false;
@@ -267,7 +267,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
         strand: &mut Strand<N>,
         ctx: &StepContext,
         report: &mut StepReport,
-        ending: Option<&LaneEnding<N, W>>,
+        ending: Option<&LaneEnding<N, W, A>>,
     ) -> Outcome {
         let Some(book) = self.lanes.get(lane).filter(|_| self.taken[lane]) else {
             return Outcome::default();
@@ -389,7 +389,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             let nodes = &book.nodes;
             evaluate_contacts::<M, N>((at, rest_length), nodes, near, layout, tolerance, found);
         }
-        let two = Wide([2.0; W]);
+        let two = Wide::new([2.0; W]);
         let mut met = Met {
             residual: core::array::from_fn(|l| self.lanes[l].rows.residual),
             converged: core::array::from_fn(|l| self.lanes[l].rows.converged),
@@ -449,7 +449,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             }
         }
         let (any_contact, longest2) = self.moves(moving);
-        let mut scale = Wide([1.0; W]);
+        let mut scale = Wide::new([1.0; W]);
         for (l, book) in self.lanes.iter_mut().enumerate() {
             if !moving.get(l) {
                 continue;
@@ -662,7 +662,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     /// ([`Self::solve_chain`]'s or [`Self::evaluate_and_eliminate`]'s) dropped `dropped`
     /// pivots: the multipliers of the lanes `solving` names. Returns each lane's dropped
     /// pivots.
-    fn back_substitute(&mut self, solving: WideMask<W>, dropped: Wide<W>) -> [u32; W] {
+    fn back_substitute(&mut self, solving: WideMask<W>, dropped: Wide<W, A>) -> [u32; W] {
         let count = self.nodes.saturating_sub(2);
         let fresh = &mut self.fresh;
         for r in (1..count).rev() {
@@ -670,7 +670,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
             fresh[r - 1] -= self.lower[r] * y;
         }
         for (old, &new) in self.multipliers.iter_mut().zip(fresh.iter()).take(count) {
-            *old = Wide(core::array::from_fn(|l| {
+            *old = Wide::new(core::array::from_fn(|l| {
                 if solving.get(l) {
                     new.0[l]
                 } else {
@@ -688,7 +688,7 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
     /// values, so the same bits. Out of line: only fixed cost takes it.
     #[inline(never)]
     fn evaluate_and_eliminate(&mut self, layout: Layout, tolerance: Real, met: &mut Met<W>) {
-        let two = Wide([2.0; W]);
+        let two = Wide::new([2.0; W]);
         let n = self.nodes.min(N);
         let mut forward = Forward::START;
         let mut above = V3::zero();
@@ -719,21 +719,21 @@ impl<const N: usize, const W: usize> BlockProjection<N, W> {
 /// The forward elimination of the chain's `L D Lᵀ`, root → tip, a row at a time: what
 /// [`BlockProjection::solve_chain`] and [`BlockProjection::evaluate_and_eliminate`] share.
 #[derive(Clone, Copy)]
-struct Forward<const W: usize> {
+struct Forward<const W: usize, A: Alignment> {
     /// `D`, `1/D` and `z` of the previous row.
-    d_above: Wide<W>,
-    inverse_above: Wide<W>,
-    z_above: Wide<W>,
+    d_above: Wide<W, A>,
+    inverse_above: Wide<W, A>,
+    z_above: Wide<W, A>,
     /// Pivots dropped so far, counted in the lanes (exact below 2^24 rows).
-    dropped: Wide<W>,
+    dropped: Wide<W, A>,
 }
 
-impl<const W: usize> Forward<W> {
+impl<const W: usize, A: Alignment> Forward<W, A> {
     const START: Self = Forward {
-        d_above: Wide([0.0; W]),
-        inverse_above: Wide([0.0; W]),
-        z_above: Wide([0.0; W]),
-        dropped: Wide([0.0; W]),
+        d_above: Wide::new([0.0; W]),
+        inverse_above: Wide::new([0.0; W]),
+        z_above: Wide::new([0.0; W]),
+        dropped: Wide::new([0.0; W]),
     };
 
     /// The next row: blocks `[p0, p1]` at its two nodes (inverse masses `w0`, `w1`),
@@ -743,15 +743,15 @@ impl<const W: usize> Forward<W> {
     #[inline(always)]
     fn row(
         &mut self,
-        [p0, p1]: [V3<Wide<W>>; 2],
-        (w0, w1): (Wide<W>, Wide<W>),
-        rhs: Wide<W>,
-        coupled: Option<V3<Wide<W>>>,
-    ) -> (Wide<W>, Wide<W>) {
+        [p0, p1]: [V3<Wide<W, A>>; 2],
+        (w0, w1): (Wide<W, A>, Wide<W, A>),
+        rhs: Wide<W, A>,
+        coupled: Option<V3<Wide<W, A>>>,
+    ) -> (Wide<W, A>, Wide<W, A>) {
         let diagonal = w0 * p0.dot(p0) + w1 * p1.dot(p1);
         let mut z = rhs;
         let mut d = diagonal;
-        let mut lower = Wide([0.0; W]);
+        let mut lower = Wide::new([0.0; W]);
         if let Some(above) = coupled {
             let below = w0 * p0.dot(above);
             lower = below * self.inverse_above;
@@ -764,10 +764,10 @@ impl<const W: usize> Forward<W> {
             let (diagonal, d) = (diagonal.0[l], d.0[l]);
             (diagonal > 0.0) & (d > PIVOT_RATIO * diagonal) & d.is_finite()
         });
-        self.dropped += Wide(kept.map(|k| if k { 0.0 } else { 1.0 }));
-        let d = Wide(core::array::from_fn(|l| if kept[l] { d.0[l] } else { 0.0 }));
+        self.dropped += Wide::new(kept.map(|k| if k { 0.0 } else { 1.0 }));
+        let d = Wide::new(core::array::from_fn(|l| if kept[l] { d.0[l] } else { 0.0 }));
         // `banded::reciprocal`: 1/d for a kept pivot, 0 for a dropped one.
-        let inverse = Wide(core::array::from_fn(|l| {
+        let inverse = Wide::new(core::array::from_fn(|l| {
             let (d, reciprocal) = (d.0[l], 1.0 / d.0[l]);
             if d > 0.0 {
                 reciprocal
@@ -786,11 +786,11 @@ impl<const W: usize> Forward<W> {
 /// where a node's segments change (nodes 0 and 1 prescribed, the tip on one segment), so that
 /// the interior runs without branches: the same operations.
 #[inline(always)]
-fn segment_moves_of<const N: usize, const W: usize>(
-    step: &mut [V3<Wide<W>>; N],
+fn segment_moves_of<const N: usize, const W: usize, A: Alignment>(
+    step: &mut [V3<Wide<W, A>>; N],
     nodes: usize,
-    (w, m): (&[Wide<W>; N], &[Wide<W>; N]),
-    blocks: impl Fn(usize) -> [V3<Wide<W>>; 2],
+    (w, m): (&[Wide<W, A>; N], &[Wide<W, A>; N]),
+    blocks: impl Fn(usize) -> [V3<Wide<W, A>>; 2],
 ) {
     let n = nodes.min(N);
     for step in step.iter_mut().take(n.min(2)) {
@@ -815,23 +815,23 @@ fn segment_moves_of<const N: usize, const W: usize>(
 /// strand alone ends strand by strand: at one lane the copies cost more than they save, and
 /// the world's scratch space (`RodScratch`, inside `hairsim_init`'s buffer) would grow by
 /// `|ê|`, `x̃` and the findings for nothing.
-pub struct LaneEnding<const N: usize, const W: usize> {
+pub struct LaneEnding<const N: usize, const W: usize, A: Alignment = Aligned> {
     /// `|ê^j|` per segment.
-    rest_length: [Wide<W>; N],
+    rest_length: [Wide<W, A>; N],
     /// The positions the projection started from (`x̃`; the strands keep them until
     /// [`BlockProjection::finish`]).
-    predicted: [V3<Wide<W>>; N],
+    predicted: [V3<Wide<W, A>>; N],
     /// What [`Self::measure`] found.
     concluded: Concluded<W>,
 }
 
-impl<const N: usize, const W: usize> LaneEnding<N, W> {
+impl<const N: usize, const W: usize, A: Alignment> LaneEnding<N, W, A> {
     /// Before its first use.
     #[must_use]
     pub const fn new() -> Self {
         LaneEnding {
-            rest_length: [Wide([0.0; W]); N],
-            predicted: [<V3<Wide<W>> as Vector<Wide<W>>>::ZERO; N],
+            rest_length: [Wide::new([0.0; W]); N],
+            predicted: [<V3<Wide<W, A>> as Vector<Wide<W, A>>>::ZERO; N],
             concluded: Concluded {
                 finite: [false; W],
                 free_stretch: [0.0; W],
@@ -845,7 +845,7 @@ impl<const N: usize, const W: usize> LaneEnding<N, W> {
     /// which the iterations are done with), whether all of a lane's are finite, and the
     /// lane's largest stretch away from and at contacts (`super::record`'s, by the same
     /// operations; a maximum does not depend on the order its values come in).
-    fn measure<M: Math>(&mut self, projection: &mut BlockProjection<N, W>, inv_dt: Real) {
+    fn measure<M: Math>(&mut self, projection: &mut BlockProjection<N, W, A>, inv_dt: Real) {
         let n = projection.nodes.min(N);
         let inv_dt = Wide::splat(inv_dt);
         let mut finite = WideMask::from_bools([true; W]);
@@ -862,7 +862,7 @@ impl<const N: usize, const W: usize> LaneEnding<N, W> {
         let (mut free, mut contact) = (zero, zero);
         for j in 0..n.saturating_sub(1) {
             let e = position[j + 1] - position[j];
-            let stretch = segment_stretch::<M, Wide<W>>(e, self.rest_length[j]);
+            let stretch = segment_stretch::<M, Wide<W, A>>(e, self.rest_length[j]);
             if any_touched {
                 let at_contact = WideMask::from_bools(core::array::from_fn(|l| {
                     touched(l, j) || touched(l, j + 1)
@@ -881,7 +881,7 @@ impl<const N: usize, const W: usize> LaneEnding<N, W> {
     }
 }
 
-impl<const N: usize, const W: usize> Default for LaneEnding<N, W> {
+impl<const N: usize, const W: usize, A: Alignment> Default for LaneEnding<N, W, A> {
     fn default() -> Self {
         Self::new()
     }
@@ -909,7 +909,13 @@ impl<const W: usize> Met<W> {
     /// rest2`), the same operations without branches but for the resolution floor (only while
     /// a lane is converged and a row exceeds the tolerance, once an evaluation at most).
     #[inline(always)]
-    fn meet(&mut self, value: Wide<W>, rest2: Wide<W>, tolerance: Real, (a, b): Ends<W>) {
+    fn meet<A: Alignment>(
+        &mut self,
+        value: Wide<W, A>,
+        rest2: Wide<W, A>,
+        tolerance: Real,
+        (a, b): Ends<W, A>,
+    ) {
         let mut floor_wanted = false;
         for l in 0..W {
             let (magnitude, rest2) = (value.0[l].abs(), rest2.0[l]);
@@ -934,13 +940,13 @@ impl<const W: usize> Met<W> {
 }
 
 /// A segment's two nodes in lanes.
-type Ends<const W: usize> = (V3<Wide<W>>, V3<Wide<W>>);
+type Ends<const W: usize, A> = (V3<Wide<W, A>>, V3<Wide<W, A>>);
 
 /// `Σ_s ∇_{x_i}C_s δλ_s` over the segments through node `i` in lane `lane`, with the
 /// gradients before the elimination (`super::segment_pull_on_node` of that strand).
-fn segment_pull<const N: usize, const W: usize>(
-    gradient: &[V3<Wide<W>>; N],
-    multipliers: &[Wide<W>; N],
+fn segment_pull<const N: usize, const W: usize, A: Alignment>(
+    gradient: &[V3<Wide<W, A>>; N],
+    multipliers: &[Wide<W, A>; N],
     n: usize,
     i: usize,
     lane: usize,

@@ -35,14 +35,14 @@ pub struct LaneBlock<const N: usize, const W: usize> {
 impl<const N: usize, const W: usize> LaneBlock<N, W> {
     /// No strand: every lane zero, `(cos θ, sin θ) = (1, 0)`.
     pub const EMPTY: Self = {
-        let zero = Wide([0.0; W]);
+        let zero = Wide::new([0.0; W]);
         let zeros = <V3<Wide<W>> as Vector<Wide<W>>>::ZERO;
         LaneBlock {
             nodes: 0,
             position: [zeros; N],
             velocity: [zeros; N],
             theta: [zero; N],
-            cos_sin: [[Wide([1.0; W]), zero]; N],
+            cos_sin: [[Wide::new([1.0; W]), zero]; N],
             root_frame: zeros,
             inverse_mass: [zero; N],
             rest: RodRest {
