@@ -20,7 +20,7 @@ use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Grab};
-use crate::lane::{Aligned, Alignment, Lane as _, Natural, Wide, WideMask, V3};
+use crate::lane::{self, Aligned, Alignment, Lane as _, Natural, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
 use crate::precision::Vector;
@@ -669,14 +669,13 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             let y = fresh[r];
             fresh[r - 1] -= self.lower[r] * y;
         }
-        for (old, &new) in self.multipliers.iter_mut().zip(fresh.iter()).take(count) {
-            *old = Wide::new(core::array::from_fn(|l| {
-                if solving.get(l) {
-                    new.0[l]
-                } else {
-                    old.0[l]
-                }
-            }));
+        // Most solves take every lane: a copy, no select.
+        if <Wide<W, A> as lane::Lane>::all(solving) {
+            self.multipliers[..count].copy_from_slice(&fresh[..count]);
+        } else {
+            for (old, &new) in self.multipliers.iter_mut().zip(fresh.iter()).take(count) {
+                *old = lane::Lane::select(solving, new, *old);
+            }
         }
         dropped.0.map(|d| d as u32)
     }
