@@ -123,7 +123,7 @@ impl Lane for Real {
 
 /// `W` scalars, one per strand of a block, laid out as `A` says: by default on 16 bytes, so
 /// that SSE2's packed arithmetic reads a lane vector straight from memory (it takes no
-/// unaligned operand: at the scalars' own alignment each operand took a load of its own, 5 %
+/// unaligned operand: at the scalars' own alignment each operand took a load of its own, 3 %
 /// of a rod block's instructions).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wide<const W: usize, A: Alignment = Aligned>(pub [Real; W], pub A);
@@ -342,7 +342,8 @@ impl<M: Math, const W: usize> Kernel for Lanes<M, W> {
     }
 }
 
-/// The twist's trigonometry lane by lane through `M`: the bits `M` gives each strand.
+/// The twist's trigonometry with the bits `M` gives each strand: in the lanes' own forms of
+/// this crate's plain functions (`Math::PLAIN_TRIGONOMETRY`), else lane by lane through `M`.
 impl<M: Math, const W: usize> Trigonometry for Lanes<M, W> {
     const PI: Wide<W> = Wide::new([core::f32::consts::PI; W]);
     const FRAC_1_PI: Wide<W> = Wide::new([core::f32::consts::FRAC_1_PI; W]);
