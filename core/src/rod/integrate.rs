@@ -82,7 +82,8 @@ pub fn symplectic_euler<P: Kernel, const N: usize>(
     // x86-64, a fixed cost per call that a step with few effects on felt.
     if <P::R as Arithmetic>::all(active) {
         // Every lane moves (one strand; a block but in its last substeps): no selects, which
-        // SSE2 spends three instructions a component on.
+        // SSE2 spends three instructions a component on. A loop of its own: as a branch in
+        // the one loop below, the blocks executed 0.5 % more instructions.
         for i in 2..n {
             let velocity = nodes.velocity[i];
             let a =
