@@ -46,16 +46,6 @@ pub trait Arithmetic:
     const EPSILON: Self;
     /// The `f32` value `x` (exact), in every lane.
     fn of(x: f32) -> Self;
-    /// `self × other`, the bits of `*`. Lanes keep it one packed multiplication on targets
-    /// that have one (`lane::packed_product`), where the compiler, given `*` on a node's
-    /// pairs of lanes, may group the lanes otherwise: in the twist's bending energies
-    /// (`rod::twist::add_node_bending`) it took three lanes together and the fourth apart,
-    /// with shuffles between, and the blocks' twist executed 21 % more instructions.
-    #[inline(always)]
-    #[must_use]
-    fn packed_product(self, other: Self) -> Self {
-        self * other
-    }
     /// `self < other`, per lane (false where either is NaN).
     fn lt(self, other: Self) -> Self::Mask;
     /// `self ≤ other`, per lane (false where either is NaN).

@@ -102,18 +102,11 @@ fn add_node_bending<P: Kernel, const N: usize>(
 ) {
     let w = material_curvature(frames.bishop_curvature[i][k], cos_sin);
     let r = rest.rest_curvature[i][k];
-    let scale = P::R::of(0.5).packed_product(rest.inverse_voronoi_length[i]);
+    let scale = P::R::of(0.5) * rest.inverse_voronoi_length[i];
     let (d0, d1) = (w[0] - r[0], w[1] - r[1]);
     let (f0, f1) = (w[0] + r[0], w[1] + r[1]);
-    // The energies' products as `packed_product`, the bits of `*`: given `*`, the compiler
-    // split a block's four lanes here (three together, one apart, shuffled between), and the
-    // blocks' twist took 21 % more instructions. The scalar forms are unchanged: `*` itself.
-    let (b0, b1) = (b[0], b[1]);
-    let at = b0.packed_product(d0).packed_product(d0) + b1.packed_product(d1).packed_product(d1);
-    let opposite =
-        b0.packed_product(f0).packed_product(f0) + b1.packed_product(f1).packed_product(f1);
-    energies.0 += at.packed_product(scale);
-    energies.1 += opposite.packed_product(scale);
+    energies.0 += (b[0] * d0 * d0 + b[1] * d1 * d1) * scale;
+    energies.1 += (b[0] * f0 * f0 + b[1] * f1 * f1) * scale;
 }
 
 /// The twist energy of nodes `j`, `j + 1` with `θ^j = candidate`, the neighbours' angles as
