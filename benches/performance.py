@@ -972,7 +972,7 @@ def c_example_section(runner):
     ]
     out = intro + [table(["", "bytes"], rows, "lr"), ""]
     _, init_s, _ = run(["llvm-objdump", "-d", "--no-show-raw-insn",
-                        "--disassemble-symbols=hairsim_init", str(elf)], quiet=True)
+                        "--disassemble-symbols=hairsim_init_versioned", str(elf)], quiet=True)
     pushes = re.findall(r"\bv?push(?:\.w)?\s+\{([^}]*)\}", init_s)
     registers = sum(len(p.split(",")) for p in pushes)
     adjust = max([int(x) for x in re.findall(r"sub(?:\.w)?\s+sp, (?:sp, )?#(\d+)", init_s)],

@@ -28,6 +28,15 @@ grep -q '^#define HAIRSIM_WORLD_SIZE [0-9]' "$tmp/capacity.h" || {
   echo "tests::header_defines printed no capacities:"; cat "$tmp/test.out"; exit 1
 } >&2
 cat >>"$tmp/capacity.h" <<'C'
+/**
+ * Makes `buffer` (`len` bytes) an empty world, after checking that the library was built for
+ * this header: its version (HAIRSIM_VERSION_MAJOR and, while that is 0, HAIRSIM_VERSION_MINOR)
+ * and its capacities (HAIRSIM_STRANDS, HAIRSIM_NODES). A mismatch returns
+ * HAIRSIM_ERROR_VERSION_MISMATCH, HAIRSIM_ERROR_STRANDS_MISMATCH or
+ * HAIRSIM_ERROR_NODES_MISMATCH and leaves the buffer alone. See hairsim_init_versioned.
+ */
+#define hairsim_init(buffer, len) \
+  hairsim_init_versioned((buffer), (len), HAIRSIM_VERSION, HAIRSIM_STRANDS, HAIRSIM_NODES)
 /** Declares a world buffer of the right size and alignment: `static HAIRSIM_WORLD_STORAGE(w);` */
 #if defined(__cplusplus)
 #define HAIRSIM_WORLD_STORAGE(name) unsigned char name alignas(HAIRSIM_WORLD_ALIGN)[HAIRSIM_WORLD_SIZE]

@@ -15,6 +15,12 @@
  * (HAIRSIM_ERROR_OK = 0); hairsim_error_message(code) says it in words. No function
  * allocates, panics or has undefined behaviour for any argument value, given pointers valid
  * for their stated lengths.
+ *
+ * Versions: HAIRSIM_VERSION_MAJOR.MINOR.PATCH is this header's, hairsim_version() the
+ * library's. While MAJOR is 0, MINOR changes whenever the C ABI changes. hairsim_init is a
+ * macro that passes the header's version and capacities to the library, which refuses a
+ * header it was not built for (HAIRSIM_ERROR_VERSION_MISMATCH, _STRANDS_MISMATCH,
+ * _NODES_MISMATCH) before it touches the buffer.
  */
 
 #ifndef HAIRSIM_H
@@ -31,6 +37,15 @@
 #define HAIRSIM_WORLD_SIZE 14576
 /** Alignment of a world buffer, bytes. */
 #define HAIRSIM_WORLD_ALIGN 8
+/**
+ * Makes `buffer` (`len` bytes) an empty world, after checking that the library was built for
+ * this header: its version (HAIRSIM_VERSION_MAJOR and, while that is 0, HAIRSIM_VERSION_MINOR)
+ * and its capacities (HAIRSIM_STRANDS, HAIRSIM_NODES). A mismatch returns
+ * HAIRSIM_ERROR_VERSION_MISMATCH, HAIRSIM_ERROR_STRANDS_MISMATCH or
+ * HAIRSIM_ERROR_NODES_MISMATCH and leaves the buffer alone. See hairsim_init_versioned.
+ */
+#define hairsim_init(buffer, len) \
+  hairsim_init_versioned((buffer), (len), HAIRSIM_VERSION, HAIRSIM_STRANDS, HAIRSIM_NODES)
 /** Declares a world buffer of the right size and alignment: `static HAIRSIM_WORLD_STORAGE(w);` */
 #if defined(__cplusplus)
 #define HAIRSIM_WORLD_STORAGE(name) unsigned char name alignas(HAIRSIM_WORLD_ALIGN)[HAIRSIM_WORLD_SIZE]
@@ -39,6 +54,30 @@
 #else
 #define HAIRSIM_WORLD_STORAGE(name) unsigned char name[HAIRSIM_WORLD_SIZE] __attribute__((aligned(HAIRSIM_WORLD_ALIGN)))
 #endif
+
+/**
+ * The library's major version. While it is 0, `HAIRSIM_VERSION_MINOR` changes whenever the C
+ * ABI does (a function, struct, constant or code changes or goes), and a header works only
+ * with a library of the same major and minor version; from 1 on, the major version changes
+ * when the ABI breaks and the minor version when it only grows.
+ */
+#define HAIRSIM_VERSION_MAJOR 0
+
+/**
+ * The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
+ */
+#define HAIRSIM_VERSION_MINOR 2
+
+/**
+ * The library's patch version: changes that no header sees (fixes, speed).
+ */
+#define HAIRSIM_VERSION_PATCH 0
+
+/**
+ * The three parts in one word, `0x00MMmmpp`, as `hairsim_version()` returns it; the header's
+ * is what the `hairsim_init` macro passes to `hairsim_init_versioned`.
+ */
+#define HAIRSIM_VERSION (((HAIRSIM_VERSION_MAJOR << 16) | (HAIRSIM_VERSION_MINOR << 8)) | HAIRSIM_VERSION_PATCH)
 
 /**
  * Most colliders a world holds.
@@ -230,6 +269,19 @@ enum hairsim_error
    * An argument's buffer overlaps the world's.
    */
   HAIRSIM_ERROR_OVERLAP = 19,
+  /**
+   * `hairsim_init`: the header's version is not one this library works with (another
+   * `HAIRSIM_VERSION_MAJOR`, or while it is 0, another `HAIRSIM_VERSION_MINOR`).
+   */
+  HAIRSIM_ERROR_VERSION_MISMATCH = 20,
+  /**
+   * `hairsim_init`: the header's `HAIRSIM_STRANDS` is not the library's.
+   */
+  HAIRSIM_ERROR_STRANDS_MISMATCH = 21,
+  /**
+   * `hairsim_init`: the header's `HAIRSIM_NODES` is not the library's.
+   */
+  HAIRSIM_ERROR_NODES_MISMATCH = 22,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -808,19 +860,35 @@ extern "C" {
 #endif // __cplusplus
 
 /**
- * Makes `buffer` an empty world with the default parameters (those of
- * `hairsim_params_default`), ready for `hairsim_configure`. `len` is the buffer's size in
- * bytes, at least `HAIRSIM_WORLD_SIZE`; the buffer is aligned to `HAIRSIM_WORLD_ALIGN`.
- * Calling it again on a world resets it. The world is written in place: no world-sized copy
- * on the stack. From then on the buffer belongs to the library: C code must not write it,
- * except through these functions. A buffer is recognised as a world by a magic word in its
- * first bytes: zero a buffer (static storage is) before its first `hairsim_init`, so that
- * bytes left from an earlier world at the same place do not pass for one.
+ * The library's version, `HAIRSIM_VERSION` of the header it was built with: `0x00MMmmpp`
+ * (major, minor, patch).
+ */
+uint32_t hairsim_version(void);
+
+/**
+ * What the header's `hairsim_init(buffer, len)` macro calls: checks that the header the
+ * caller was compiled with (its `HAIRSIM_VERSION`, `HAIRSIM_STRANDS` and `HAIRSIM_NODES`,
+ * which the macro passes) matches this library, then makes `buffer` an empty world with the
+ * default parameters (those of `hairsim_params_default`), ready for `hairsim_configure`.
+ * A mismatch is refused before the buffer is touched: `HAIRSIM_ERROR_VERSION_MISMATCH`,
+ * `HAIRSIM_ERROR_STRANDS_MISMATCH` or `HAIRSIM_ERROR_NODES_MISMATCH`.
+ *
+ * `len` is the buffer's size in bytes, at least `HAIRSIM_WORLD_SIZE`; the buffer is aligned to
+ * `HAIRSIM_WORLD_ALIGN`. Calling it again on a world resets it. The world is written in place:
+ * no world-sized copy on the stack. From then on the buffer belongs to the library: C code
+ * must not write it, except through these functions. A buffer is recognised as a world by a
+ * magic word in its first bytes: zero a buffer (static storage is) before its first
+ * `hairsim_init`, so that bytes left from an earlier world at the same place do not pass for
+ * one.
  *
  * # Safety
  * `buffer`, if not NULL, must be valid for reads and writes of `len` bytes.
  */
-hairsim_error hairsim_init(struct hairsim_world *buffer, size_t len);
+hairsim_error hairsim_init_versioned(struct hairsim_world *buffer,
+                                     size_t len,
+                                     uint32_t version,
+                                     uint32_t strands,
+                                     uint32_t nodes);
 
 /**
  * Fills `out` with the core's default parameters: rod solver, 1 ms, gravity only, converge

@@ -247,19 +247,84 @@ fn code(r: Result<()>) -> hairsim_error {
     }
 }
 
-/// Makes `buffer` an empty world with the default parameters (those of
-/// `hairsim_params_default`), ready for `hairsim_configure`. `len` is the buffer's size in
-/// bytes, at least `HAIRSIM_WORLD_SIZE`; the buffer is aligned to `HAIRSIM_WORLD_ALIGN`.
-/// Calling it again on a world resets it. The world is written in place: no world-sized copy
-/// on the stack. From then on the buffer belongs to the library: C code must not write it,
-/// except through these functions. A buffer is recognised as a world by a magic word in its
-/// first bytes: zero a buffer (static storage is) before its first `hairsim_init`, so that
-/// bytes left from an earlier world at the same place do not pass for one.
+/// Whether a header of version `version` (`HAIRSIM_VERSION`) built for `strands` × `nodes`
+/// matches this library: the same major version and, while it is 0, the same minor version
+/// (from 1 on, a minor version no newer than the library's); the same capacities.
+fn check_header(version: u32, strands: u32, nodes: u32) -> Result<()> {
+    let (major, minor) = (version >> 16, (version >> 8) & 0xff);
+    let minor_works = if HAIRSIM_VERSION_MAJOR == 0 {
+        minor == HAIRSIM_VERSION_MINOR
+    } else {
+        minor <= HAIRSIM_VERSION_MINOR
+    };
+    if major != HAIRSIM_VERSION_MAJOR || !minor_works {
+        Err(hairsim_error::VersionMismatch)
+    } else if strands as usize != STRANDS {
+        Err(hairsim_error::StrandsMismatch)
+    } else if nodes as usize != NODES {
+        Err(hairsim_error::NodesMismatch)
+    } else {
+        Ok(())
+    }
+}
+
+/// The library's version, `HAIRSIM_VERSION` of the header it was built with: `0x00MMmmpp`
+/// (major, minor, patch).
+#[no_mangle]
+pub extern "C" fn hairsim_version() -> u32 {
+    HAIRSIM_VERSION
+}
+
+/// What the header's `hairsim_init(buffer, len)` macro calls: checks that the header the
+/// caller was compiled with (its `HAIRSIM_VERSION`, `HAIRSIM_STRANDS` and `HAIRSIM_NODES`,
+/// which the macro passes) matches this library, then makes `buffer` an empty world with the
+/// default parameters (those of `hairsim_params_default`), ready for `hairsim_configure`.
+/// A mismatch is refused before the buffer is touched: `HAIRSIM_ERROR_VERSION_MISMATCH`,
+/// `HAIRSIM_ERROR_STRANDS_MISMATCH` or `HAIRSIM_ERROR_NODES_MISMATCH`.
+///
+/// `len` is the buffer's size in bytes, at least `HAIRSIM_WORLD_SIZE`; the buffer is aligned to
+/// `HAIRSIM_WORLD_ALIGN`. Calling it again on a world resets it. The world is written in place:
+/// no world-sized copy on the stack. From then on the buffer belongs to the library: C code
+/// must not write it, except through these functions. A buffer is recognised as a world by a
+/// magic word in its first bytes: zero a buffer (static storage is) before its first
+/// `hairsim_init`, so that bytes left from an earlier world at the same place do not pass for
+/// one.
 ///
 /// # Safety
 /// `buffer`, if not NULL, must be valid for reads and writes of `len` bytes.
 #[no_mangle]
-pub unsafe extern "C" fn hairsim_init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
+pub unsafe extern "C" fn hairsim_init_versioned(
+    buffer: *mut hairsim_world,
+    len: usize,
+    version: u32,
+    strands: u32,
+    nodes: u32,
+) -> hairsim_error {
+    if let Err(e) = check_header(version, strands, nodes) {
+        return e;
+    }
+    // SAFETY: the caller's promise.
+    unsafe { init(buffer, len) }
+}
+
+/// What the header's `hairsim_init` macro does, for Rust callers of this crate (its tests, the
+/// fuzz target): `hairsim_init_versioned` with this library's own version and capacities.
+///
+/// # Safety
+/// As `hairsim_init_versioned`.
+pub unsafe fn hairsim_init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
+    // SAFETY: the caller's promise.
+    unsafe { hairsim_init_versioned(buffer, len, HAIRSIM_VERSION, STRANDS as u32, NODES as u32) }
+}
+
+/// Makes `buffer` an empty world (`hairsim_init_versioned`, after its header check).
+///
+/// # Safety
+/// As `hairsim_init_versioned`.
+// Inlined, so that `.ci/ffi` finds the world's construction in `hairsim_init_versioned`'s
+// frame.
+#[inline(always)]
+unsafe fn init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
     let cell = buffer.cast::<Cell>();
     if let Err(e) = check_ptr(cell) {
         return e;
@@ -812,6 +877,9 @@ pub extern "C" fn hairsim_error_message(code: i32) -> *const c_char {
         17 => c"a collider is out of range (finite, a radius from 1e-5 to 1e4 m, a unit normal)",
         18 => c"a grab names no strand, a node outside 2 to the last, or a force limit <= 0",
         19 => c"an argument's buffer overlaps the world's",
+        20 => c"hairsim.h is of another version than the library (HAIRSIM_VERSION_MAJOR, MINOR)",
+        21 => c"hairsim.h was generated for another HAIRSIM_STRANDS than the library",
+        22 => c"hairsim.h was generated for another HAIRSIM_NODES than the library",
         _ => c"unknown error code",
     };
     message.as_ptr()

@@ -136,6 +136,55 @@ fn the_capacity_function_tells_the_layout() {
 }
 
 #[test]
+fn init_refuses_a_header_of_another_version_or_capacity() {
+    let mut storage = Storage::new();
+    let (world, len) = (storage.world(), storage.len());
+    let (strands, nodes) = (STRANDS as u32, NODES as u32);
+    let init = |version, strands, nodes| unsafe {
+        hairsim_init_versioned(world, len, version, strands, nodes)
+    };
+    let version = |major: u32, minor: u32, patch: u32| (major << 16) | (minor << 8) | patch;
+    assert_eq!(hairsim_version(), HAIRSIM_VERSION);
+    assert_eq!(
+        env!("CARGO_PKG_VERSION"),
+        format!("{HAIRSIM_VERSION_MAJOR}.{HAIRSIM_VERSION_MINOR}.{HAIRSIM_VERSION_PATCH}")
+    );
+    let (major, minor) = (HAIRSIM_VERSION_MAJOR, HAIRSIM_VERSION_MINOR);
+    for refused in [
+        version(major + 1, minor, 0),
+        version(major, minor + 1, 0),
+        version(major, minor.wrapping_sub(1) & 0xff, 0),
+        0,
+        u32::MAX,
+    ] {
+        assert_eq!(
+            init(refused, strands, nodes),
+            E::VersionMismatch,
+            "{refused:#x}"
+        );
+    }
+    assert_eq!(
+        init(HAIRSIM_VERSION, strands + 1, nodes),
+        E::StrandsMismatch
+    );
+    assert_eq!(init(HAIRSIM_VERSION, strands, nodes - 1), E::NodesMismatch);
+    // A version mismatch is told first: the other numbers may mean something else there.
+    assert_eq!(init(0, strands + 1, nodes + 1), E::VersionMismatch);
+    // Refused before the buffer is touched: NULL is not looked at.
+    let refused = unsafe { hairsim_init_versioned(ptr::null_mut(), 0, 0, strands, nodes) };
+    assert_eq!(refused, E::VersionMismatch);
+    let mut h = 0;
+    assert_eq!(
+        unsafe { hairsim_state_hash(world, &mut h) },
+        E::NotInitialised
+    );
+    // Another patch version works.
+    let patched = version(major, minor, HAIRSIM_VERSION_PATCH + 1);
+    assert_eq!(init(patched, strands, nodes), E::Ok);
+    assert_eq!(init(HAIRSIM_VERSION, strands, nodes), E::Ok);
+}
+
+#[test]
 fn the_firmware_scene_through_the_c_functions_gives_the_core_hash() {
     let scene = Scene::firmware();
     let mut storage = Storage::new();
@@ -510,7 +559,7 @@ fn refused_arguments_have_their_codes() {
             let message = core::ffi::CStr::from_ptr(hairsim_error_message(code));
             assert!(!message.is_empty());
             let unknown = message.to_str().unwrap() == "unknown error code";
-            assert_eq!(unknown, !(0..=19).contains(&code), "{code}");
+            assert_eq!(unknown, !(0..=22).contains(&code), "{code}");
         }
     }
 }

@@ -6,6 +6,41 @@
 //! field is a `u32` checked on the way in.
 #![allow(non_camel_case_types)]
 
+/// The library's major version. While it is 0, `HAIRSIM_VERSION_MINOR` changes whenever the C
+/// ABI does (a function, struct, constant or code changes or goes), and a header works only
+/// with a library of the same major and minor version; from 1 on, the major version changes
+/// when the ABI breaks and the minor version when it only grows.
+pub const HAIRSIM_VERSION_MAJOR: u32 = 0;
+/// The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
+pub const HAIRSIM_VERSION_MINOR: u32 = 2;
+/// The library's patch version: changes that no header sees (fixes, speed).
+pub const HAIRSIM_VERSION_PATCH: u32 = 0;
+/// The three parts in one word, `0x00MMmmpp`, as `hairsim_version()` returns it; the header's
+/// is what the `hairsim_init` macro passes to `hairsim_init_versioned`.
+pub const HAIRSIM_VERSION: u32 =
+    (HAIRSIM_VERSION_MAJOR << 16) | (HAIRSIM_VERSION_MINOR << 8) | HAIRSIM_VERSION_PATCH;
+
+/// `text` as a number: the parts of Cargo's package version, at compile time.
+const fn parse_u32(text: &str) -> u32 {
+    let bytes = text.as_bytes();
+    let mut value = 0;
+    let mut i = 0;
+    while i < bytes.len() {
+        assert!(bytes[i].is_ascii_digit(), "a version part is a number");
+        value = value * 10 + (bytes[i] - b'0') as u32;
+        i += 1;
+    }
+    value
+}
+// The header's version is the crate's (`ffi/Cargo.toml`): a mismatch fails the build. Each
+// part takes one byte of `HAIRSIM_VERSION`.
+const _: () = assert!(HAIRSIM_VERSION_MAJOR == parse_u32(env!("CARGO_PKG_VERSION_MAJOR")));
+const _: () = assert!(HAIRSIM_VERSION_MINOR == parse_u32(env!("CARGO_PKG_VERSION_MINOR")));
+const _: () = assert!(HAIRSIM_VERSION_PATCH == parse_u32(env!("CARGO_PKG_VERSION_PATCH")));
+const _: () = assert!(
+    HAIRSIM_VERSION_MAJOR < 256 && HAIRSIM_VERSION_MINOR < 256 && HAIRSIM_VERSION_PATCH < 256
+);
+
 /// Most colliders a world holds.
 pub const HAIRSIM_MAX_COLLIDERS: usize = 8;
 /// Most grabs a world holds.
@@ -101,6 +136,13 @@ pub enum hairsim_error {
     InvalidGrab = 18,
     /// An argument's buffer overlaps the world's.
     Overlap = 19,
+    /// `hairsim_init`: the header's version is not one this library works with (another
+    /// `HAIRSIM_VERSION_MAJOR`, or while it is 0, another `HAIRSIM_VERSION_MINOR`).
+    VersionMismatch = 20,
+    /// `hairsim_init`: the header's `HAIRSIM_STRANDS` is not the library's.
+    StrandsMismatch = 21,
+    /// `hairsim_init`: the header's `HAIRSIM_NODES` is not the library's.
+    NodesMismatch = 22,
 }
 
 /// The model (`hairsim_params::solver`).

@@ -34,6 +34,7 @@ static const char *name_of(hairsim_error code) {
         "NOT_FINITE", "OUT_OF_RANGE", "UNSUPPORTED_EFFECT", "TOO_FEW_NODES", "TOO_MANY_NODES",
         "DEGENERATE_SEGMENT", "FOLDED_SEGMENT", "INVALID_MATERIAL", "STRANDS_FULL",
         "COLLIDERS_FULL", "GRABS_FULL", "INVALID_COLLIDER", "INVALID_GRAB", "OVERLAP",
+        "VERSION_MISMATCH", "STRANDS_MISMATCH", "NODES_MISMATCH",
     };
     return code >= 0 && (size_t)code < sizeof names / sizeof names[0] ? names[code] : "?";
 }
@@ -100,6 +101,30 @@ static void refusals(void) {
           "the library's capacities are the header's");
     check(cap.world_size <= HAIRSIM_WORLD_SIZE && cap.world_align <= HAIRSIM_WORLD_ALIGN,
           "the header's world buffer is large and aligned enough");
+
+    /* The header's version and capacities: another minor version (while the major one is 0),
+       major version, strand or node capacity than the library's is refused. */
+    check(hairsim_version() == HAIRSIM_VERSION, "the library's version is the header's");
+    const uint32_t other_minor = HAIRSIM_VERSION ^ (1u << 8);
+    const uint32_t other_major = HAIRSIM_VERSION + (1u << 16);
+    const uint32_t other_patch = HAIRSIM_VERSION ^ 1u;
+    EXPECT(HAIRSIM_ERROR_VERSION_MISMATCH,
+           hairsim_init_versioned(world, sizeof refusal_storage, other_minor, HAIRSIM_STRANDS,
+                                  HAIRSIM_NODES));
+    EXPECT(HAIRSIM_ERROR_VERSION_MISMATCH,
+           hairsim_init_versioned(world, sizeof refusal_storage, other_major, HAIRSIM_STRANDS,
+                                  HAIRSIM_NODES));
+    EXPECT(HAIRSIM_ERROR_STRANDS_MISMATCH,
+           hairsim_init_versioned(world, sizeof refusal_storage, HAIRSIM_VERSION,
+                                  HAIRSIM_STRANDS + 1, HAIRSIM_NODES));
+    EXPECT(HAIRSIM_ERROR_NODES_MISMATCH,
+           hairsim_init_versioned(world, sizeof refusal_storage, HAIRSIM_VERSION,
+                                  HAIRSIM_STRANDS, HAIRSIM_NODES * 2));
+    EXPECT(HAIRSIM_ERROR_NOT_INITIALISED, hairsim_release_grab(world, 0));
+    EXPECT(HAIRSIM_ERROR_OK,
+           hairsim_init_versioned(world, sizeof refusal_storage, other_patch, HAIRSIM_STRANDS,
+                                  HAIRSIM_NODES));
+    memset(bytes, 0, HAIRSIM_WORLD_SIZE);
 
     /* The world buffer: NULL, misaligned, short, uninitialised. */
     EXPECT(HAIRSIM_ERROR_NULL_POINTER, hairsim_init(NULL, HAIRSIM_WORLD_SIZE));
