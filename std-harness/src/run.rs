@@ -29,7 +29,8 @@ pub struct Loaded {
     pub prepared: Prepared,
 }
 
-/// Loads SCENE: a built-in name, a TOML scene file, or a `.hair`/`.tfx` hair file.
+/// Loads SCENE: a built-in name, a TOML scene file, or a hair file (`.hair`, `.tfx`, or
+/// hairsim's `.obj`, `.ply`, `.usda`).
 pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
     if let Some(b) = builtin::find(spec) {
         let scene = (b.scene)();
@@ -41,8 +42,7 @@ pub fn load(spec: &str, hair: &HairFileOptions) -> Result<Loaded> {
         });
     }
     let path = Path::new(spec);
-    let lower = spec.to_ascii_lowercase();
-    if lower.ends_with(".hair") || lower.ends_with(".tfx") {
+    if crate::hairfile::is_hair_file(spec) {
         let scene_error = |e: crate::scene::FieldError| {
             anyhow!(SceneError {
                 file: format!("{spec} (default scene)"),

@@ -247,6 +247,13 @@ enum FileFormat {
     Usda,
 }
 
+/// Whether a file called `name` is a hair file this module reads, by its extension: `.hair`,
+/// `.tfx`, or hairsim's own `.obj`, `.ply`, `.usda` exports.
+#[must_use]
+pub fn is_hair_file(name: &str) -> bool {
+    reader_for(name).is_ok()
+}
+
 /// The format a file called `name` holds, by its extension.
 fn reader_for(name: &str) -> Result<FileFormat, HairFileError> {
     let ext = Path::new(name)
