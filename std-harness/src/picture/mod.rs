@@ -2,6 +2,13 @@
 //! disc, capsule → stadium, plane → edge line with its solid side shaded), seen through an
 //! orthographic camera; PNG stills and animated GIFs written a frame at a time.
 //!
+//! The look of `hairsim view`'s page (`std-harness/viewer/web/look.js` and `render-gl.js`) as
+//! far as a CPU rasteriser allows: the same colours and light, each piece of a strand shaded
+//! by the page's Kajiya–Kay terms (diffuse from the angle between the strand and the light,
+//! a narrow white highlight and a broad tinted one) and its depth cue (hair on the far side
+//! of the light is darker), in a few steps of brightness; spheres and capsules lit by
+//! gradients toward the light.
+//!
 //! Drawn with `tiny-skia`. Strand segments and colliders are painted far to near (a painter's
 //! algorithm over segment midpoints and collider centres), so hair behind the head is hidden by
 //! it and hair in front covers it.
@@ -11,7 +18,8 @@ mod gif_writer;
 
 use hairsim_core::{Shape, Vec3};
 use tiny_skia::{
-    Color, FillRule, LineCap, LineJoin, Paint, PathBuilder, Pixmap, Point, Stroke, Transform,
+    Color, FillRule, GradientStop, LineCap, LineJoin, LinearGradient, Paint, PathBuilder, Pixmap,
+    Point, RadialGradient, Shader, SpreadMode, Stroke, Transform,
 };
 
 pub use camera::{Camera, View, MARGIN};
@@ -67,17 +75,57 @@ pub struct Style {
 }
 
 impl Default for Style {
+    /// The page's colours (`look.js`).
     fn default() -> Self {
         Style {
-            background: [250, 250, 247],
+            background: [21, 23, 28],
             root: [58, 32, 18],
             tip: [222, 168, 84],
             strand_width: 1.0,
-            collider_fill: [196, 204, 214],
-            collider_edge: [96, 106, 120],
-            plane_fill: [226, 228, 222],
+            collider_fill: [150, 160, 176],
+            collider_edge: [40, 44, 54],
+            plane_fill: [34, 38, 46],
         }
     }
+}
+
+/// Toward the light, from the hair (world, Y up): the page's light (`look.js`).
+const LIGHT: Vec3 = Vec3::new(0.45, 0.8, 0.4);
+
+/// Steps of the shading's brightness: each is a colour of its own, and so a stroke.
+const LIGHT_STEPS: f32 = 6.0;
+
+/// The page's hair shading (`render-gl.js`) for a piece along unit `tangent` at `point`:
+/// the factor on its colour and the white added (0 ..= 1), each in [`LIGHT_STEPS`] steps.
+/// `view` points from the hair to the camera; `volume` is the hair's centre and radius.
+fn shading(tangent: Vec3, point: Vec3, view: Vec3, volume: (Vec3, f32)) -> (f32, f32) {
+    let light = LIGHT.normalize();
+    let half = (light + view).normalize();
+    let (tl, th) = (tangent.dot(light), tangent.dot(half));
+    let diffuse = (1.0 - tl * tl).max(0.0).sqrt();
+    let sin_th = (1.0 - th * th).max(0.0).sqrt();
+    let depth = (0.5 - 0.5 * (point - volume.0).dot(light) / volume.1).clamp(0.0, 1.0);
+    let shadow = 1.0 + (0.35 - 1.0) * depth;
+    let factor = 0.25 + 0.75 * diffuse * shadow + 0.45 * sin_th.powi(18) * shadow;
+    let white = 0.3 * sin_th.powi(90) * shadow;
+    let step = |x: f32| (x * LIGHT_STEPS).round() / LIGHT_STEPS;
+    (step(factor), step(white))
+}
+
+/// The hair's centre and radius (the depth cue's volume).
+fn volume<S: AsRef<[Vec3]>>(strands: &[S]) -> (Vec3, f32) {
+    let finite = || {
+        strands
+            .iter()
+            .flat_map(AsRef::as_ref)
+            .filter(|p| p.is_finite())
+    };
+    let count = finite().count().max(1) as f32;
+    let centre = finite().fold(Vec3::ZERO, |sum, p| sum + *p) / count;
+    let radius = finite()
+        .map(|p| (*p - centre).length())
+        .fold(1e-3, f32::max);
+    (centre, radius)
 }
 
 impl Style {
@@ -176,7 +224,20 @@ impl Solid {
     }
 }
 
-fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid) {
+/// A solid's fill as `gradient` makes it from two stops: the fill's own colour where the light
+/// falls (the gradient's start), a third of it on the far side (its end).
+fn lit(
+    style: &Style,
+    gradient: impl FnOnce(Vec<GradientStop>) -> Option<Shader<'static>>,
+) -> Shader<'static> {
+    let stops = vec![
+        GradientStop::new(0.0, colour(brighten(style.collider_fill, 1.05))),
+        GradientStop::new(1.0, colour(brighten(style.collider_fill, 0.35))),
+    ];
+    gradient(stops).unwrap_or(Shader::SolidColor(colour(style.collider_fill)))
+}
+
+fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid, light: (f32, f32)) {
     let mut paint = Paint {
         anti_alias: true,
         ..Paint::default()
@@ -184,7 +245,15 @@ fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid) {
     match *solid {
         Solid::Disc { centre, radius } => {
             if let Some(path) = PathBuilder::from_circle(centre.x, centre.y, radius.max(0.5)) {
-                paint.set_color(colour(style.collider_fill));
+                let bright = Point::from_xy(
+                    centre.x + 0.45 * radius * light.0,
+                    centre.y + 0.45 * radius * light.1,
+                );
+                paint.shader = lit(style, |stops| {
+                    let reach = 1.45 * radius.max(0.5);
+                    let (mode, at) = (SpreadMode::Pad, Transform::identity());
+                    RadialGradient::new(bright, bright, reach, stops, mode, at)
+                });
                 pixmap.fill_path(
                     &path,
                     &paint,
@@ -208,11 +277,32 @@ fn draw_solid(pixmap: &mut Pixmap, style: &Style, solid: &Solid) {
             // A zero-length axis still gets round caps from a tiny nudge.
             path.line_to(b.x + 1e-3, b.y);
             if let Some(path) = path.finish() {
-                for (c, w) in [
-                    (style.collider_edge, 2.0 * radius + 3.0),
-                    (style.collider_fill, 2.0 * radius),
+                // Across the axis, toward the light: the lit side of the cylinder.
+                let (ax, ay) = (b.x - a.x, b.y - a.y);
+                let length = (ax * ax + ay * ay).sqrt().max(1e-6);
+                let mut normal = (-ay / length, ax / length);
+                if normal.0 * light.0 + normal.1 * light.1 < 0.0 {
+                    normal = (-normal.0, -normal.1);
+                }
+                let middle = Point::from_xy(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+                let side = |k: f32| {
+                    Point::from_xy(
+                        middle.x + k * radius * normal.0,
+                        middle.y + k * radius * normal.1,
+                    )
+                };
+                let fill = lit(style, |stops| {
+                    let (mode, at) = (SpreadMode::Pad, Transform::identity());
+                    LinearGradient::new(side(0.8), side(-1.0), stops, mode, at)
+                });
+                for (shader, w) in [
+                    (
+                        Shader::SolidColor(colour(style.collider_edge)),
+                        2.0 * radius + 3.0,
+                    ),
+                    (fill, 2.0 * radius),
                 ] {
-                    paint.set_color(colour(c));
+                    paint.shader = shader;
                     let stroke = Stroke {
                         width: w.max(1.0),
                         line_cap: LineCap::Round,
@@ -296,6 +386,13 @@ pub fn render<S: AsRef<[Vec3]>>(
     // has one shade of the root → tip ramp (SHADES steps), made a little lighter or darker per
     // strand (a fixed hash of its index) so dense hair shows strands rather than bands.
     let mut layers: Vec<Vec<Piece>> = (0..=solids.len()).map(|_| Vec::new()).collect();
+    let hair = volume(strands);
+    let view = -camera.view.axes().2;
+    let light = {
+        let (x, y) = camera.project_direction(LIGHT.normalize());
+        let length = (x * x + y * y).sqrt().max(1e-6);
+        (x / length, y / length)
+    };
     for (index, strand) in strands.iter().enumerate() {
         let strand = strand.as_ref();
         let tint = strand_tint(index);
@@ -309,6 +406,8 @@ pub fn render<S: AsRef<[Vec3]>>(
             }
             let ((a, da), (b, db)) = (camera.project(pair[0]), camera.project(pair[1]));
             let depth = 0.5 * (da + db);
+            let tangent = (pair[1] - pair[0]).normalize_or_zero();
+            let (factor, white) = shading(tangent, 0.5 * (pair[0] + pair[1]), view, hair);
             let layer = solids.iter().take_while(|(d, _)| *d > depth).count();
             let Some(layer) = layers.get_mut(layer) else {
                 continue;
@@ -320,7 +419,7 @@ pub fn render<S: AsRef<[Vec3]>>(
                 let shade = ((t * SHADES as f32) as usize).min(SHADES - 1);
                 let ramp = mix(style.root, style.tip, (shade as f32 + 0.5) / SHADES as f32);
                 layer.push(Piece {
-                    colour: brighten(ramp, tint),
+                    colour: mix(brighten(ramp, tint * factor), [255; 3], white),
                     a: at(u0),
                     b: at(u1),
                 });
@@ -331,7 +430,7 @@ pub fn render<S: AsRef<[Vec3]>>(
     for (k, layer) in layers.iter().enumerate() {
         draw_pieces(&mut pixmap, style, layer);
         if let Some((_, solid)) = solids.get(k) {
-            draw_solid(&mut pixmap, style, solid);
+            draw_solid(&mut pixmap, style, solid, light);
         }
     }
     Ok(pixmap)
