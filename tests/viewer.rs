@@ -130,3 +130,94 @@ fn the_hand_pulls_the_hair_toward_its_target_harder_the_further_it_drags() {
     assert_eq!(session.status()["grab"], "none");
     assert_eq!(session.status()["grab_force"][0], 0.0);
 }
+
+/// The rod with inextensibility off stretches its strands many times over until every strand
+/// is rolled back at every step (the page says the simulation is stuck); turned back on, the
+/// stretched strands are pulled back and the hair moves again: no roll-back and every
+/// segment within 1 % of its rest length over the next second.
+#[test]
+fn inextensibility_turned_back_on_recovers_the_hair() {
+    let mut session = Session::load(Source::builtin("head-2").unwrap()).unwrap();
+    assert_eq!(session.status()["solver"], "rod");
+    session.step(100);
+    session.set_effect(Effect::Inextensibility, false).unwrap();
+    session.step(400);
+    session.take_events();
+    session.step(100);
+    let stuck = session.take_events();
+    assert_eq!(stuck["all_rolled_back"], 100, "{stuck}");
+    assert!(stuck["max_stretch"].as_f64().unwrap() > 1.0, "{stuck}");
+    let hash = session.status()["state_hash"].clone();
+    session.step(10);
+    assert_eq!(
+        session.status()["state_hash"],
+        hash,
+        "stuck: the state no longer changes"
+    );
+    session.take_events();
+
+    session.set_effect(Effect::Inextensibility, true).unwrap();
+    // The first steps push pulled-back nodes out of the head (a contact stretches its
+    // segments until the projection catches up); from the second tenth of a second on,
+    // every segment is within 1 %.
+    for tenth in 0..10 {
+        session.step(100);
+        let events = session.take_events();
+        assert_eq!(events["rolled_back_max"], 0, "tenth {tenth}: {events}");
+        let stretch = events["max_stretch"].as_f64().unwrap();
+        assert!(tenth == 0 || stretch < 0.01, "tenth {tenth}: {events}");
+    }
+    assert_ne!(session.status()["state_hash"], hash);
+}
+
+/// An effect the scene cannot use is refused with the reason the panel shows beside it.
+#[test]
+fn effects_a_scene_cannot_use_say_why() {
+    let mut session = Session::load(Source::builtin("head-2").unwrap()).unwrap();
+    let unusable = session.status()["unusable"].clone();
+    for (effect, reason) in [
+        ("wind", "no [wind]"),
+        ("grabs", "no [[grabs]]"),
+        ("shape", "rod has no shape"),
+        ("hair-hair", "not in the page"),
+    ] {
+        let said = unusable[effect].as_str().unwrap_or_default();
+        assert!(said.contains(reason), "{effect}: {said:?}");
+    }
+    assert!(unusable.get("gravity").is_none(), "{unusable}");
+    let error = session.set_effect(Effect::Wind, true).unwrap_err();
+    assert!(
+        error.starts_with("wind: the scene has no [wind]"),
+        "{error}"
+    );
+}
+
+/// hairsim's own `.obj`, `.ply` and `.usda` exports run as hair files: by path in `hairsim
+/// run` and dropped on the page as bytes, with the same bits.
+#[test]
+fn hairsims_text_exports_run_as_hair_files() {
+    let loaded = load("head-1", &HairFileOptions::default()).unwrap();
+    let strands: Vec<Vec<Vec3>> = loaded
+        .prepared
+        .strands
+        .iter()
+        .map(|s| s.points.clone())
+        .collect();
+    let dir = std::env::temp_dir().join(format!("hairsim-viewer-exports-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for format in ["obj", "ply", "usda"] {
+        let name = format!("groom.{format}");
+        let path = dir.join(&name);
+        hairsim::export::save(&path, &strands).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let page = viewer_hash(
+            Source::HairFile {
+                name: name.clone(),
+                bytes,
+            },
+            20,
+        );
+        assert_eq!(page, native_hash(path.to_str().unwrap(), 20), "{name}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -17,6 +17,10 @@ use crate::scene::{prepare::hair_file_path, HairSpec};
 /// harness was built without that target.
 pub const WASM: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/hairsim_viewer.wasm"));
 
+/// The same built with WebAssembly's 128-bit SIMD (`simd128`), which the page loads where the
+/// browser has it: the same bits, faster.
+pub const WASM_SIMD: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/hairsim_viewer_simd.wasm"));
+
 /// A file of the page: where it is served and what it holds.
 struct Asset {
     path: &'static str,
@@ -27,27 +31,35 @@ struct Asset {
 const HTML: &str = "text/html; charset=utf-8";
 const SCRIPT: &str = "text/javascript; charset=utf-8";
 
+/// One of the page's files in `std-harness/viewer/web`, served at `/NAME`.
+macro_rules! page_file {
+    ($name:literal, $content_type:expr) => {
+        Asset {
+            path: concat!("/", $name),
+            content_type: $content_type,
+            bytes: include_bytes!(concat!("../viewer/web/", $name)),
+        }
+    };
+}
+
 /// The page's files, embedded in the binary.
 const ASSETS: &[Asset] = &[
-    Asset {
-        path: "/index.html",
-        content_type: HTML,
-        bytes: include_bytes!("../viewer/web/index.html"),
-    },
-    Asset {
-        path: "/viewer.js",
-        content_type: SCRIPT,
-        bytes: include_bytes!("../viewer/web/viewer.js"),
-    },
-    Asset {
-        path: "/simulation.js",
-        content_type: SCRIPT,
-        bytes: include_bytes!("../viewer/web/simulation.js"),
-    },
+    page_file!("index.html", HTML),
+    page_file!("viewer.js", SCRIPT),
+    page_file!("simulation.js", SCRIPT),
+    page_file!("clock.js", SCRIPT),
+    page_file!("look.js", SCRIPT),
+    page_file!("render-gl.js", SCRIPT),
+    page_file!("render-2d.js", SCRIPT),
     Asset {
         path: "/hairsim_viewer.wasm",
         content_type: "application/wasm",
         bytes: WASM,
+    },
+    Asset {
+        path: "/hairsim_viewer_simd.wasm",
+        content_type: "application/wasm",
+        bytes: WASM_SIMD,
     },
 ];
 
@@ -71,8 +83,7 @@ pub fn initial(spec: &str) -> Result<Source> {
         return Source::builtin(name).map_err(|e| anyhow!(e));
     }
     let path = Path::new(spec);
-    let lower = spec.to_ascii_lowercase();
-    if lower.ends_with(".hair") || lower.ends_with(".tfx") {
+    if crate::hairfile::is_hair_file(spec) {
         let bytes = std::fs::read(path).with_context(|| format!("{spec}: cannot read"))?;
         return Ok(Source::HairFile {
             name: file_name(path),
@@ -248,9 +259,11 @@ mod tests {
         let (status, body) = get(&url, "/");
         assert!(status.contains("200"), "{status}");
         assert!(String::from_utf8_lossy(&body).contains("viewer.js"));
-        let (status, body) = get(&url, "/hairsim_viewer.wasm");
-        assert!(status.contains("200"), "{status}");
-        assert_eq!(&body[..4], b"\0asm");
+        for module in ["/hairsim_viewer.wasm", "/hairsim_viewer_simd.wasm"] {
+            let (status, body) = get(&url, module);
+            assert!(status.contains("200"), "{module}: {status}");
+            assert_eq!(&body[..4], b"\0asm", "{module}");
+        }
         let (_, body) = get(&url, "/initial.json?x=1");
         assert_eq!(body, br#"{"kind":"builtin","name":"firmware-dftl"}"#);
         let (status, _) = get(&url, "/initial");

@@ -27,6 +27,8 @@ struct State {
     output: String,
     positions: Vec<f32>,
     offsets: Vec<u32>,
+    floats: Vec<f32>,
+    bytes: Vec<u8>,
 }
 
 thread_local! {
@@ -77,6 +79,21 @@ fn on_session(f: impl FnOnce(&mut Session) -> Result<(), String>) -> i32 {
     with(|state| {
         let result = match state.session.as_mut() {
             Some(session) => f(session),
+            None => Err("no scene loaded".into()),
+        };
+        answer(state, result)
+    })
+}
+
+/// Runs `f` on the session and puts the text it gives into the output (an error when none is
+/// loaded).
+fn output_of(f: impl FnOnce(&mut Session) -> String) -> i32 {
+    with(|state| {
+        let result = match state.session.as_mut() {
+            Some(session) => {
+                state.output = f(session);
+                Ok(())
+            }
             None => Err("no scene loaded".into()),
         };
         answer(state, result)
@@ -159,6 +176,19 @@ pub extern "C" fn hs_load_scene_file(
     })
 }
 
+/// The file name of the hair file the scene file in the input reads (its name, then its
+/// text) into the output: empty if it reads none.
+#[no_mangle]
+pub extern "C" fn hs_scene_hair_file(name_len: u32, text_len: u32) -> i32 {
+    with(|state| {
+        let [name, scene] = pieces(&state.input, [name_len, text_len]);
+        let result = crate::session::scene_hair_file(&text(name), &text(scene)).map(|file| {
+            state.output = file.unwrap_or_default();
+        });
+        answer(state, result)
+    })
+}
+
 /// Advances the scene by `steps` steps; returns the steps taken since the start (0 with no
 /// scene).
 #[no_mangle]
@@ -217,19 +247,61 @@ pub extern "C" fn hs_offsets_len() -> u32 {
     with(|s| u32::try_from(s.offsets.len()).unwrap_or(0))
 }
 
+/// The followers into the float buffer ([`hs_floats_ptr`]: leader index, then the root
+/// offset in the head's frame, four floats each); returns their number.
+#[no_mangle]
+pub extern "C" fn hs_followers() -> u32 {
+    with(|state| {
+        match &state.session {
+            Some(session) => session.followers(&mut state.floats),
+            None => state.floats.clear(),
+        }
+        u32::try_from(state.floats.len() / 4).unwrap_or(0)
+    })
+}
+
+/// The address of the float buffer.
+#[no_mangle]
+pub extern "C" fn hs_floats_ptr() -> *const f32 {
+    with(|s| s.floats.as_ptr())
+}
+
+/// One byte of flags per strand (`stepper::flag`) into the byte buffer ([`hs_bytes_ptr`]);
+/// returns the number of strands.
+#[no_mangle]
+pub extern "C" fn hs_strand_flags() -> u32 {
+    with(|state| {
+        match state.session.as_mut() {
+            Some(session) => session.strand_flags(&mut state.bytes),
+            None => state.bytes.clear(),
+        }
+        u32::try_from(state.bytes.len()).unwrap_or(0)
+    })
+}
+
+/// The address of the byte buffer.
+#[no_mangle]
+pub extern "C" fn hs_bytes_ptr() -> *const u8 {
+    with(|s| s.bytes.as_ptr())
+}
+
+/// What the steps since the last call reported, as JSON into the output (counting starts
+/// anew).
+#[no_mangle]
+pub extern "C" fn hs_events() -> i32 {
+    output_of(|session| session.take_events().to_string())
+}
+
+/// The scene as the page has edited it, as a scene file, into the output.
+#[no_mangle]
+pub extern "C" fn hs_scene_toml() -> i32 {
+    output_of(|session| session.scene_toml())
+}
+
 /// The session's status as JSON into the output.
 #[no_mangle]
 pub extern "C" fn hs_status() -> i32 {
-    with(|state| {
-        let result = match state.session.as_ref() {
-            Some(session) => {
-                state.output = session.status().to_string();
-                Ok(())
-            }
-            None => Err("no scene loaded".into()),
-        };
-        answer(state, result)
-    })
+    output_of(|session| session.status().to_string())
 }
 
 /// Switches to the rod (1) or DFTL (0), restarting the scene.

@@ -13,10 +13,10 @@ use hairsim_core::{DefaultMath, Effect, GrabStatus, Real, Shape, Solver, Vec3};
 use hairsim_files::builtin;
 use hairsim_files::hairscene::{scene_for_hair_file_in, HairFileOptions};
 use hairsim_files::scene::start::scene_inputs;
-use hairsim_files::scene::{locate, FieldError, HairFiles, Prepared, RodSpec, Scene};
+use hairsim_files::scene::{locate, FieldError, HairFiles, HairSpec, Prepared, RodSpec, Scene};
 use serde_json::{json, Value};
 
-use crate::stepper::Stepper;
+use crate::stepper::{Events, Stepper};
 
 /// Largest force the hand's grab transmits before it slips, N: far above what a strand's
 /// weight and stiffness put on it, so it slips only when the pointer leaves the strand's reach.
@@ -87,7 +87,7 @@ impl Source {
             Source::HairFile { name, .. } => {
                 let path = Path::new(name);
                 scene_for_hair_file_in(path, &HairFileOptions::default(), self.files())
-                    .map_err(|e| format!("{name} (default scene): {e}"))
+                    .map_err(|e| self.error(&e))
             }
             Source::SceneFile { name, text, .. } => {
                 Scene::from_toml(text, name).map_err(|e| e.to_string())
@@ -99,10 +99,41 @@ impl Source {
     fn error(&self, error: &FieldError) -> String {
         match self {
             Source::Builtin(name) => error.in_builtin(name).to_string(),
-            Source::HairFile { name, .. } => format!("{name} (default scene): {error}"),
+            Source::HairFile { name, .. } => {
+                // The reader's message names the file already ("sintel.tfx: …"): the page
+                // says it as it is, not as a field of the default scene around it.
+                let unread = format!("cannot read \"{name}\": ");
+                let named = format!("{name}: ");
+                match error.message.strip_prefix(&unread) {
+                    Some(message) if error.field == "hair.file.path" => {
+                        format!(
+                            "{name}: {}",
+                            message.strip_prefix(&named).unwrap_or(message)
+                        )
+                    }
+                    _ => format!("{name} (default scene): {error}"),
+                }
+            }
             Source::SceneFile { name, text, .. } => locate(error, name, text).to_string(),
         }
     }
+}
+
+/// The file name of the hair file the scene file `name` (its `text`) reads, if any: what the
+/// page needs dropped with it.
+///
+/// # Errors
+/// The scene file does not parse (its message, placed in the file).
+pub fn scene_hair_file(name: &str, text: &str) -> Result<Option<String>, String> {
+    let scene = Scene::from_toml(text, name).map_err(|e| e.to_string())?;
+    Ok(match scene.hair {
+        Some(HairSpec::File(file)) => Some(
+            Path::new(&file.path)
+                .file_name()
+                .map_or_else(|| file.path.clone(), |n| n.to_string_lossy().into_owned()),
+        ),
+        _ => None,
+    })
 }
 
 /// The running strands at the capacity the scene needs (the harness's rule: 32 nodes, else
@@ -188,6 +219,12 @@ impl Session {
         }
     }
 
+    /// The scene as the page has edited it, as a scene file (`hairsim run` runs it).
+    #[must_use]
+    pub fn scene_toml(&self) -> String {
+        self.scene.to_toml()
+    }
+
     /// Steps taken since the start.
     #[must_use]
     pub fn steps(&self) -> u64 {
@@ -203,6 +240,43 @@ impl Session {
     /// Every node's position into `out` and each strand's first node into `offsets`.
     pub fn positions(&self, out: &mut Vec<f32>, offsets: &mut Vec<u32>) {
         each!(&self.running, s => s.positions(out, offsets));
+    }
+
+    /// The followers drawn around the leaders (`hairsim run --out` draws them too): four
+    /// floats each into `out`, the leader's index and the root offset in the head's frame, m.
+    pub fn followers(&self, out: &mut Vec<f32>) {
+        out.clear();
+        for f in &self.prepared.followers {
+            // Exact: leader indices stay far below 2^24.
+            #[allow(clippy::cast_precision_loss)]
+            out.push(f.leader as f32);
+            out.extend_from_slice(&f.offset.to_array());
+        }
+    }
+
+    /// One byte of flags per strand (`stepper::flag`) into `out`.
+    pub fn strand_flags(&mut self, out: &mut Vec<u8>) {
+        each!(&mut self.running, s => s.strand_flags(out));
+    }
+
+    /// What the steps since the last call reported, as JSON (and starts counting anew).
+    pub fn take_events(&mut self) -> Value {
+        let Events {
+            steps,
+            all_rolled_back,
+            rolled_back_max,
+            cap_hits_max,
+            max_stretch,
+            slipped,
+        } = each!(&mut self.running, s => s.take_events());
+        json!({
+            "steps": steps,
+            "all_rolled_back": all_rolled_back,
+            "rolled_back_max": rolled_back_max,
+            "cap_hits_max": cap_hits_max,
+            "max_stretch": max_stretch,
+            "slipped_at": slipped,
+        })
     }
 
     /// The scene edited by `edit`, checked; on success the new plan, the scene kept.
@@ -248,13 +322,39 @@ impl Session {
         self.reset()
     }
 
+    /// Why the running scene cannot use `effect` (none: it can).
+    #[must_use]
+    pub fn unusable(&self, effect: Effect) -> Option<String> {
+        let solver = self.prepared.params.solver;
+        Some(match effect {
+            Effect::HairHair => "hair–hair (SPH) runs in `hairsim run`, not in the page".into(),
+            _ if !solver.supports(effect) => {
+                let other = match solver {
+                    Solver::Rod => "DFTL",
+                    Solver::Dftl => "the rod",
+                };
+                format!(
+                    "{} has no {}: switch to {other}",
+                    solver.name(),
+                    effect.name()
+                )
+            }
+            Effect::Wind if self.scene.wind.is_none() => "the scene has no [wind] table".into(),
+            Effect::Grabs if self.scene.grabs.is_empty() => {
+                "the scene has no [[grabs]]: press on a strand to grab it".into()
+            }
+            _ => return None,
+        })
+    }
+
     /// Turns `effect` on or off in the running scene.
     ///
     /// # Errors
-    /// The scene's checks refuse it (hair–hair always: the page has no SPH).
+    /// Turned on where the running scene cannot use it ([`Session::unusable`]), or the
+    /// scene's checks refuse it.
     pub fn set_effect(&mut self, effect: Effect, on: bool) -> Result<(), String> {
-        if effect == Effect::HairHair {
-            return Err("hair-hair (SPH) runs in `hairsim run`, not in the page".into());
+        if let Some(reason) = self.unusable(effect).filter(|_| on) {
+            return Err(format!("{}: {reason}", effect.name()));
         }
         self.edited(|scene| {
             scene.effects.retain(|e| e != effect.name());
@@ -264,6 +364,9 @@ impl Session {
         })?;
         if !on && effect == Effect::Grabs {
             self.release();
+        }
+        if on && effect == Effect::Inextensibility {
+            each!(&mut self.running, s => s.restore_stretched());
         }
         self.apply_params()
     }
@@ -320,13 +423,17 @@ impl Session {
     #[must_use]
     pub fn status(&self) -> Value {
         let params = &self.prepared.params;
-        let (hand, colliders, report) = each!(&self.running, s => (
+        let (hand, held, head, colliders, report) = each!(&self.running, s => (
             s.hand(),
+            s.held_node(),
+            s.head,
             s.colliders_now().map(shape_json).collect::<Vec<_>>(),
             json!({
                 "contacts": s.report.contacts,
                 "rolled_back": s.report.rolled_back,
                 "max_stretch": s.report.max_stretch,
+                "cap_hits": s.report.cap_hits,
+                "iterations_max": s.report.iterations_max,
             }),
         ));
         let (grab, force, target) = match hand {
@@ -350,19 +457,24 @@ impl Session {
             "state_hash": format!("{:#018x}", self.state_hash()),
             "solver": match params.solver { Solver::Rod => "rod", Solver::Dftl => "dftl" },
             "effects": params.effects.iter().map(Effect::name).collect::<Vec<_>>(),
-            "supported": Effect::ALL
+            "unusable": Effect::ALL
                 .into_iter()
-                .filter(|e| *e != Effect::HairHair && params.solver.supports(*e))
-                .map(Effect::name)
-                .collect::<Vec<_>>(),
+                .filter_map(|e| Some((e.name().to_string(), self.unusable(e)?.into())))
+                .collect::<serde_json::Map<_, _>>(),
             "hair_hair_dropped": self.hair_hair_dropped,
             "twist": params.rod.twist.name(),
             "grab": grab,
             "grab_force": force.to_array(),
             "grab_target": target,
+            "grab_limit": HAND_FORCE_LIMIT,
+            "held": held.map(|(strand, node, at)| json!({
+                "strand": strand, "node": node, "position": at.to_array(),
+            })),
+            "head": { "position": head.position.to_array(), "rotation": head.rotation.to_array() },
             "report": report,
             "colliders": colliders,
             "strands": self.prepared.strands.len(),
+            "followers": self.prepared.followers.len(),
             "nodes": self.prepared.nodes(),
         })
     }

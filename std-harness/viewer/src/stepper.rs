@@ -1,17 +1,47 @@
 //! One running scene at strand capacity `N`: the core's pipeline, on one thread, with the
-//! scene's grabs and the hand's. The bits are those of `hairsim run`: the harness splits the
-//! strands into blocks (and DFTL into lanes) only for speed, and every one of its layouts
-//! gives the state of one `step_strands` call over all the strands.
+//! scene's grabs and the hand's, in the lanes `hairsim run` steps them in (the rod's strands
+//! [`ROD_LANES`] at a time, DFTL's as structure-of-arrays blocks of [`DFTL_LANES`]). The bits
+//! are those of `hairsim run`: every layout of the core gives the state of one
+//! `step_strands` call over all the strands.
 
+use hairsim_core::dftl::{collisions, follow_leader, DftlBlock};
 use hairsim_core::grab::MAX_GRABS;
+use hairsim_core::lane::V3;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
-    step_strands, Collider, DefaultMath, Grab, GrabStatus, Params, Pose, Real, Shape, StepReport,
-    Strand, Vec3,
+    step_blocks, step_strands_in_lanes_with, Collider, DefaultMath, Grab, GrabStatus, Params, Pose,
+    Real, RodBlockScratch, Shape, Solver, StepReport, Strand, Vec3,
 };
+use hairsim_files::lanes::{load_state, VectorSqrt, DFTL_LANES, ROD_LANES};
 use hairsim_files::scene::start::StepInputs;
 use hairsim_files::scene::{FieldError, Prepared};
+
+/// The math of the lanes: the default backend with the hardware's square root (the same
+/// bits; `wasm32` has no other fast one).
+type LaneMath = VectorSqrt<DefaultMath>;
+
+/// The strands' lanes: the rod's scratch space, or DFTL's blocks (rest data loaded once, the
+/// state copied in and out every step).
+#[derive(Debug)]
+enum Lanes<const N: usize> {
+    Rod(Box<RodBlockScratch<LaneMath, N, ROD_LANES>>),
+    Dftl(Vec<DftlBlock<DFTL_LANES, N>>),
+}
+
+impl<const N: usize> Lanes<N> {
+    fn new(solver: Solver, strands: &[Strand<N>]) -> Self {
+        match solver {
+            Solver::Rod => Lanes::Rod(Box::default()),
+            Solver::Dftl => Lanes::Dftl(
+                strands
+                    .chunks(DFTL_LANES)
+                    .map(DftlBlock::from_strands)
+                    .collect(),
+            ),
+        }
+    }
+}
 
 /// A grab held by the page's pointer.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -21,6 +51,38 @@ pub struct Hand {
     /// Where the pointer holds the node, m.
     pub target: Vec3,
 }
+
+/// What the steps since the page last asked ([`Stepper::take_events`]) reported: what the
+/// page must show as it happens rather than leave to one step's report.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Events {
+    /// Steps taken.
+    pub steps: u32,
+    /// Steps in which every strand was rolled back.
+    pub all_rolled_back: u32,
+    /// Most strands rolled back in one step.
+    pub rolled_back_max: u32,
+    /// Most strands whose projection hit its iteration cap in one step.
+    pub cap_hits_max: u32,
+    /// Largest stretch: of a segment without contact in the reports (`max_stretch`), and of
+    /// any segment of the strands as they are when the events are taken.
+    pub max_stretch: Real,
+    /// Whether the hand's grab slipped, and the force it held before (N).
+    pub slipped: Option<Real>,
+}
+
+/// Per-strand flags of [`Stepper::strand_flags`].
+pub mod flag {
+    /// Rolled back since the page last asked.
+    pub const ROLLED_BACK: u8 = 1;
+    /// A segment stretched by more than [`super::STRETCH_WARNING`].
+    pub const STRETCHED: u8 = 2;
+    /// The hand holds (or held, before it slipped) this strand.
+    pub const HELD: u8 = 4;
+}
+
+/// Relative stretch past which a strand is drawn in the warning colour: 1 %.
+pub const STRETCH_WARNING: Real = 0.01;
 
 /// The strands, colliders and grabs of a scene, stepped by the core.
 #[derive(Debug)]
@@ -40,6 +102,12 @@ pub struct Stepper<const N: usize> {
     pub steps: u64,
     /// The last step's report.
     pub report: StepReport,
+    lanes: Lanes<N>,
+    events: Events,
+    /// [`flag::ROLLED_BACK`] of each strand since the page last asked.
+    rolled_back: Vec<bool>,
+    /// The force the hand's grab held at the last step it held, N.
+    held_force: Real,
 }
 
 impl<const N: usize> Stepper<N> {
@@ -50,6 +118,10 @@ impl<const N: usize> Stepper<N> {
     pub fn new(prepared: &Prepared) -> Result<Self, FieldError> {
         let (strands, head) = prepared.start_strands::<N, DefaultMath>()?;
         Ok(Stepper {
+            lanes: Lanes::new(prepared.params.solver, &strands),
+            events: Events::default(),
+            rolled_back: vec![false; strands.len()],
+            held_force: 0.0,
             params: prepared.params,
             dftl: prepared.params.dftl.at_step(prepared.params.dt),
             strands,
@@ -96,11 +168,85 @@ impl<const N: usize> Stepper<N> {
             released: &released[..count],
         };
         let ctx = pipeline::begin(world, &inputs, &mut report);
-        step_strands::<DefaultMath, N>(&ctx, &mut self.strands, 0, &self.grabs, None, &mut report);
+        match &mut self.lanes {
+            Lanes::Rod(scratch) => {
+                let at = (0, self.grabs.as_slice());
+                step_strands_in_lanes_with(&ctx, &mut self.strands, at, None, scratch, &mut report);
+            }
+            Lanes::Dftl(blocks) => {
+                for (block, strands) in blocks.iter_mut().zip(self.strands.chunks(DFTL_LANES)) {
+                    load_state(block, strands);
+                }
+                step_blocks::<LaneMath, DFTL_LANES, N>(&ctx, blocks, 0, None, &mut report);
+                for (block, strands) in blocks.iter().zip(self.strands.chunks_mut(DFTL_LANES)) {
+                    block.store(strands);
+                }
+            }
+        }
         pipeline::finish(&mut self.grabs, &report);
         self.head = ctx.head;
         self.steps += 1;
         self.report = report;
+        self.count_events();
+    }
+
+    /// Adds the last step's report to the events and the strands' flags.
+    fn count_events(&mut self) {
+        let report = &self.report;
+        let events = &mut self.events;
+        events.steps += 1;
+        let all = u32::try_from(self.strands.len()).unwrap_or(u32::MAX);
+        if report.rolled_back >= all && all > 0 {
+            events.all_rolled_back += 1;
+            self.rolled_back.fill(true);
+        }
+        for &s in &report.rolled_back_strands {
+            if let Some(flag) = self.rolled_back.get_mut(s as usize) {
+                *flag = true;
+            }
+        }
+        events.rolled_back_max = events.rolled_back_max.max(report.rolled_back);
+        events.cap_hits_max = events.cap_hits_max.max(report.cap_hits);
+        events.max_stretch = events.max_stretch.max(report.max_stretch);
+        if let Some(hand) = self.hand {
+            let slipped = report.grabs_slipped & (1 << hand.grab) != 0;
+            if slipped {
+                events.slipped = Some(self.held_force);
+            } else if self.grabs.get(hand.grab).map(|g| g.status) == Some(GrabStatus::Held) {
+                self.held_force = report.grab_forces[hand.grab].length();
+            }
+        }
+    }
+
+    /// The events since the last call (and starts counting anew), the stretch as the strands
+    /// are now too: a rolled-back strand's report measures the step the guard threw away.
+    pub fn take_events(&mut self) -> Events {
+        let now = self.strands.iter().map(stretch).fold(0.0, Real::max);
+        let mut events = std::mem::take(&mut self.events);
+        events.max_stretch = events.max_stretch.max(now);
+        events
+    }
+
+    /// One byte of [`flag`]s per strand into `out`; the roll-backs are counted anew.
+    pub fn strand_flags(&mut self, out: &mut Vec<u8>) {
+        out.clear();
+        let held = self
+            .hand
+            .and_then(|hand| self.grabs.get(hand.grab))
+            .map(|grab| grab.strand as usize);
+        for (s, strand) in self.strands.iter().enumerate() {
+            let mut flags = 0;
+            if std::mem::take(&mut self.rolled_back[s]) {
+                flags |= flag::ROLLED_BACK;
+            }
+            if stretch(strand) > STRETCH_WARNING {
+                flags |= flag::STRETCHED;
+            }
+            if held == Some(s) {
+                flags |= flag::HELD;
+            }
+            out.push(flags);
+        }
     }
 
     /// The state hash of every strand (what `hairsim run --json` prints).
@@ -164,6 +310,7 @@ impl<const N: usize> Stepper<N> {
             grab: self.grabs.len() - 1,
             target,
         });
+        self.held_force = 0.0;
         Ok(())
     }
 
@@ -172,6 +319,40 @@ impl<const N: usize> Stepper<N> {
         if let Some(hand) = self.hand.as_mut() {
             hand.target = target;
         }
+    }
+
+    /// Pulls every strand stretched past [`STRETCH_WARNING`] back to its rest lengths (see
+    /// [`restore_lengths`]); returns how many it pulled. For inextensibility turned back on: the
+    /// projection, from a strand stretched many times over, cannot get back within its cap
+    /// before the guard rolls the strand back to the same stretched state, every step.
+    pub fn restore_stretched(&mut self) -> usize {
+        let shapes: Vec<Shape> = self.colliders_now().collect();
+        let mut pulled = 0;
+        for strand in &mut self.strands {
+            if stretch(strand) > STRETCH_WARNING {
+                restore_lengths(strand, &shapes);
+                if sharpest_fold(strand) < FOLD_COSINE {
+                    rest_shape(strand, &self.head);
+                }
+                pulled += 1;
+            }
+        }
+        if let Lanes::Dftl(blocks) = &mut self.lanes {
+            for (block, strands) in blocks.iter_mut().zip(self.strands.chunks(DFTL_LANES)) {
+                load_state(block, strands);
+            }
+        }
+        pulled
+    }
+
+    /// The held node's position (where the hand's grab holds it, or where it went after a
+    /// slip), with its strand and node.
+    #[must_use]
+    pub fn held_node(&self) -> Option<(usize, usize, Vec3)> {
+        let grab = self.grabs.get(self.hand?.grab)?;
+        let (strand, node) = (grab.strand as usize, grab.node as usize);
+        let position = *self.strands.get(strand)?.state.position.get(node)?;
+        Some((strand, node, position))
     }
 
     /// Lets go of the hand's grab: it leaves the world, its force with it.
@@ -194,4 +375,66 @@ impl<const N: usize> Stepper<N> {
         };
         Some((hand, grab.status, force))
     }
+}
+
+/// The largest relative stretch `| |e| − |ê| | / |ê|` of a segment of `strand`.
+fn stretch<const N: usize>(strand: &Strand<N>) -> Real {
+    let positions = strand.positions();
+    positions
+        .windows(2)
+        .zip(&strand.rest.segment_length)
+        .map(|(pair, &rest)| ((pair[1] - pair[0]).length() - rest).abs() / rest.max(Real::EPSILON))
+        .fold(0.0, Real::max)
+}
+
+/// The cosine of the sharpest fold [`Stepper::restore_stretched`] keeps (120°: what the rod's
+/// fixed-cost substeps allow for); a strand pulled back into a sharper one goes to its rest
+/// shape instead (the rod rolls back a strand folded into a near hairpin step after step).
+const FOLD_COSINE: Real = -0.5;
+
+/// The cosine of the sharpest turning angle between consecutive segments of `strand`.
+fn sharpest_fold<const N: usize>(strand: &Strand<N>) -> Real {
+    strand
+        .positions()
+        .windows(3)
+        .map(|p| {
+            (p[1] - p[0])
+                .normalize_or_zero()
+                .dot((p[2] - p[1]).normalize_or_zero())
+        })
+        .fold(1.0, Real::min)
+}
+
+/// `strand` in its rest shape where the head is now, at rest.
+fn rest_shape<const N: usize>(strand: &mut Strand<N>, head: &Pose) {
+    let nodes = strand.nodes();
+    for (x, rest) in strand.state.position[..nodes]
+        .iter_mut()
+        .zip(&strand.rest.position)
+    {
+        *x = head.transform_point(*rest);
+    }
+    strand.state.velocity[..nodes].fill(Vec3::ZERO);
+}
+
+/// Pulls each segment of `strand` back to its rest length, root to tip, along its present
+/// direction, and each node out of the colliders `shapes` — DFTL's follow-the-leader step and
+/// its collisions (SB15 eq. 10 and Algorithm 1 line 20: [`follow_leader::project`],
+/// [`collisions::push_out`]) without the dynamics — and stops the strand (zero velocity).
+/// Nodes 0 and 1 stay with the head.
+fn restore_lengths<const N: usize>(strand: &mut Strand<N>, shapes: &[Shape]) {
+    let nodes = strand.nodes();
+    let state = &mut strand.state;
+    for i in 2..nodes {
+        let previous = V3::from(state.position[i - 1]);
+        let fallback = V3::from(Vec3::NEG_Y);
+        let length = strand.rest.segment_length[i - 1];
+        let x = state.position[i].into();
+        let (mut x, _) = follow_leader::project::<LaneMath, Real>(previous, x, length, fallback);
+        for shape in shapes {
+            x = collisions::push_out::<LaneMath, Real>(shape, x).0;
+        }
+        state.position[i] = x.into();
+    }
+    state.velocity[..nodes].fill(Vec3::ZERO);
 }

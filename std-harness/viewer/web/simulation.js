@@ -5,15 +5,26 @@
 const encoder = new TextEncoder();
 const decoder = new TextDecoder();
 
+// The smallest module that uses a 128-bit SIMD instruction (a function returning
+// `i8x16.splat(0)`): a browser that validates it runs the `simd128` build.
+const SIMD_PROBE = new Uint8Array([
+  0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0, 10, 8, 1, 6, 0, 65, 0, 253, 15, 11,
+]);
+
+export const HAS_SIMD = WebAssembly.validate(SIMD_PROBE);
+
 export class Simulation {
-  static async load(url = "hairsim_viewer.wasm") {
-    const response = await fetch(url);
-    const { instance } = await WebAssembly.instantiateStreaming(response, {});
-    return new Simulation(instance.exports);
+  // The `simd128` build where the browser has it (unless `simd` is false), else the build
+  // without SIMD; both give the same bits.
+  static async load(simd = HAS_SIMD) {
+    const url = simd && HAS_SIMD ? "hairsim_viewer_simd.wasm" : "hairsim_viewer.wasm";
+    const { instance } = await WebAssembly.instantiateStreaming(fetch(url), {});
+    return new Simulation(instance.exports, url);
   }
 
-  constructor(exports) {
+  constructor(exports, module) {
     this.x = exports;
+    this.module = module;
   }
 
   // Copies `parts` (strings or byte arrays) into the module's input buffer, one after the
@@ -74,6 +85,38 @@ export class Simulation {
     const points = new Float32Array(buffer, this.x.hs_positions_ptr(), 3 * nodes);
     const offsets = new Uint32Array(buffer, this.x.hs_offsets_ptr(), this.x.hs_offsets_len());
     return { points, offsets };
+  }
+
+  // The followers: leader index and root offset (head frame, m), four floats each; a view
+  // of the module's memory, valid until the next call.
+  followers() {
+    const count = this.x.hs_followers();
+    return new Float32Array(this.x.memory.buffer, this.x.hs_floats_ptr(), 4 * count);
+  }
+
+  // One byte of flags per strand (1 rolled back since the last call, 2 stretched past 1 %,
+  // 4 held by the hand); a view of the module's memory, valid until the next call.
+  strandFlags() {
+    const count = this.x.hs_strand_flags();
+    return new Uint8Array(this.x.memory.buffer, this.x.hs_bytes_ptr(), count);
+  }
+
+  // What the steps since the last call reported (roll-backs, stretch, cap hits, a slip).
+  events() {
+    this.check(this.x.hs_events());
+    return JSON.parse(this.output());
+  }
+
+  // The file name of the hair file a scene file reads ("" if none).
+  sceneHairFile(name, text) {
+    this.check(this.x.hs_scene_hair_file(...this.input(name, text)));
+    return this.output();
+  }
+
+  // The scene as the page has edited it, as a scene file.
+  sceneToml() {
+    this.check(this.x.hs_scene_toml());
+    return this.output();
   }
 
   status() {

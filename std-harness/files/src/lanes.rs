@@ -1,0 +1,60 @@
+//! What the harness's threads and the page's single thread share to step strands in lanes:
+//! the lanes' square root ([`VectorSqrt`]) and a DFTL block's state copied in from its strands
+//! ([`load_state`]). The core's block paths give the bits of its per-strand path; these keep
+//! them so.
+
+use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
+use hairsim_core::{Math, Real, Strand};
+
+/// Lanes of the DFTL blocks.
+pub const DFTL_LANES: usize = RECOMMENDED_LANES;
+/// Lanes of the rod's blocks (`hairsim_core::pipeline::rod::step_block`).
+pub const ROD_LANES: usize = 4;
+
+/// The backend `M` with the hardware's square root, which the compiler can vectorise
+/// (`libm::sqrtf` is a scalar `sqrtss` on x86-64 and a software loop on `wasm32`, where
+/// `f32::sqrt` is one `f32.sqrt`, or one `f32x4.sqrt` for four lanes with `simd128`).
+/// [`Math::sqrt`] is correctly rounded in every backend and so is `f32::sqrt`: the same bits;
+/// the trigonometry stays `M`'s.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VectorSqrt<M>(std::marker::PhantomData<M>);
+
+impl<M: Math> Math for VectorSqrt<M> {
+    const NAME: &'static str = M::NAME;
+    const PLAIN_TRIGONOMETRY: bool = M::PLAIN_TRIGONOMETRY;
+    #[inline(always)]
+    fn sqrt(x: Real) -> Real {
+        x.sqrt()
+    }
+    #[inline(always)]
+    fn sin_cos(x: Real) -> (Real, Real) {
+        M::sin_cos(x)
+    }
+    #[inline(always)]
+    fn atan2(y: Real, x: Real) -> Real {
+        M::atan2(y, x)
+    }
+}
+
+/// Copies the state (positions, velocities) of `strands` into the lanes of `block` they were
+/// loaded into (lane `l` from `strands[l]`): the inverse of [`DftlBlock::store`]. The rest
+/// data stays as loaded.
+pub fn load_state<const N: usize>(block: &mut DftlBlock<DFTL_LANES, N>, strands: &[Strand<N>]) {
+    for (l, strand) in strands
+        .iter()
+        .enumerate()
+        .take(block.strands.min(DFTL_LANES))
+    {
+        let n = block.nodes[l].min(N);
+        for (lanes, (x, v)) in block.state.iter_mut().zip(
+            strand.state.position[..n]
+                .iter()
+                .zip(&strand.state.velocity[..n]),
+        ) {
+            for (axis, (p, u)) in x.to_array().into_iter().zip(v.to_array()).enumerate() {
+                lanes.position[axis][l] = p;
+                lanes.velocity[axis][l] = u;
+            }
+        }
+    }
+}
