@@ -606,13 +606,15 @@ window.hairsim = {
   // optimised, while the first, quickly compiled code runs.
   benchmark: (steps) => {
     sim.reset();
-    for (let warm = performance.now(); performance.now() - warm < 1000 && sim.step(1) < steps;);
+    const warm = performance.now();
+    let warmed = 0;
+    // At least 200 ms: the browser optimises a function after it has run a while.
+    for (let t = 0; (warmed < steps || t < 200) && t < 1000; t = performance.now() - warm) warmed = sim.step(1);
+    // Batches of at least 2 ms at the warm steps' mean cost.
+    const batch = Math.max(1, Math.ceil((2 * warmed) / Math.max(1e-3, performance.now() - warm)));
     sim.reset();
-    const t0 = performance.now();
-    sim.step(1);
-    const batch = Math.max(1, Math.ceil(2 / Math.max(1e-3, performance.now() - t0)));
     const costs = [];
-    for (let done = 1; done < steps; done += batch) {
+    for (let done = 0; done < steps; done += batch) {
       const n = Math.min(batch, steps - done);
       const start = performance.now();
       sim.step(n);
