@@ -117,7 +117,8 @@ mod rod_blocks {
         p
     }
 
-    /// The plan each strand of `strands` would make for this step (its schedule untouched).
+    /// The plan each strand of `strands` would make for this step (its schedule untouched; no
+    /// grab holds them).
     fn plans<M: Math>(ctx: &StepContext, strands: &[Strand<N>]) -> Vec<Integration> {
         let mut frames = RodFrames::<M, N>::empty();
         strands
@@ -125,7 +126,7 @@ mod rod_blocks {
             .map(|s| {
                 frames.refresh(s);
                 let mut schedule = s.schedule;
-                plan(ctx, &s.rest.rod, &mut schedule, || {
+                plan(ctx, &s.rest.rod, (&mut schedule, false), || {
                     smallest_binormal_denominator(&frames, &s.rest.rod.rest_length)
                 })
             })

@@ -1,11 +1,11 @@
 //! The firmware under QEMU prints the same state hash as the host for the same scene.
 //!
 //! `.ci/run` runs the firmware example under `qemu-system-arm -machine mps2-an386`, saves what
-//! it printed and points `HAIRSIM_FIRMWARE_LOG` at it. This test compares that hash with the
-//! one `hairsim run firmware` computes on the host.
+//! it printed and points `HAIRSIM_FIRMWARE_LOG` at it. This test compares its hashes of the
+//! `firmware`, `firmware-dftl` and `haptic-dftl` scenes with the host's.
 
 use hairsim::run::{run_builtin, RunOptions};
-use hairsim_core::scenes::firmware_dftl;
+use hairsim_core::scenes::{firmware_dftl, haptic_dftl};
 use hairsim_core::{Libm, World};
 
 fn firmware_hash(log: &str, scene: &str) -> Option<String> {
@@ -40,6 +40,24 @@ fn firmware_under_qemu_prints_the_host_hash() {
         format!("0x{host:016x}"),
         target,
         "host and Cortex-M4F DFTL hashes differ"
+    );
+
+    // The haptic DFTL scene: a strand held through a coupling, the same bits on both.
+    let target = firmware_hash(&log, "haptic-dftl")
+        .unwrap_or_else(|| panic!("no `scene haptic-dftl … state_hash` line in:\n{log}"));
+    let mut world: Box<World<{ haptic_dftl::STRANDS }, { haptic_dftl::NODES }, Libm>> =
+        Box::default();
+    let host = haptic_dftl::run(&mut world, haptic_dftl::STEPS).unwrap();
+    assert_eq!(
+        format!("0x{host:016x}"),
+        target,
+        "host and Cortex-M4F haptic DFTL hashes differ"
+    );
+    // And the harness's built-in scene of the same name.
+    let harness = run_builtin("haptic-dftl", &RunOptions::default()).unwrap();
+    assert_eq!(
+        harness.state_hash, target,
+        "hairsim run haptic-dftl differs"
     );
 }
 

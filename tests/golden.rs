@@ -77,14 +77,17 @@ const TABLE: &[Golden] = &[
     g("haptic", "rod", "hair-optimised", 1000, 0x6326bbc9b2489344),
     g("haptic", "rod", "newton", 1000, 0x6326bbc9b2489344),
     g("haptic", "dftl", "-", 1000, 0xde0cc33db142c350),
+    g("haptic-dftl", "dftl", "-", 1000, 0),
+    g("haptic-dftl", "rod", "hair-optimised", 1000, 0),
+    g("haptic-dftl", "rod", "newton", 1000, 0),
 ];
 
 /// The rod's largest time step (`Params::validate`).
 const ROD_DT_MAX: f32 = 0.004;
 
 /// The built-in scene `row.scene`, switched to `row.solver` and `row.twist`. Effects the other
-/// solver cannot simulate are dropped (with the grabs, for DFTL), and a DFTL scene run by the
-/// rod takes the rod's largest time step if its own is larger; nothing else changes.
+/// solver cannot simulate are dropped, and a DFTL scene run by the rod takes the rod's largest
+/// time step if its own is larger; nothing else changes.
 fn configured(row: &Golden) -> Scene {
     let mut scene = (builtin::find(row.scene).expect("a built-in scene").scene)();
     let solver = match row.solver {
@@ -97,7 +100,6 @@ fn configured(row: &Golden) -> Scene {
         .retain(|name| Effect::from_name(name).is_some_and(|effect| solver.supports(effect)));
     match solver {
         Solver::Dftl => {
-            scene.grabs.clear();
             scene.rod = None;
         }
         Solver::Rod => {

@@ -157,9 +157,7 @@ impl Solver {
     pub const fn supports(self, effect: Effect) -> bool {
         match self {
             Solver::Rod => !matches!(effect, Effect::Shape),
-            // DFTL has no grab constraint (its single root-to-tip pass cannot hold a middle
-            // node): refused, not silently ignored.
-            Solver::Dftl => !matches!(effect, Effect::Bending | Effect::Twist | Effect::Grabs),
+            Solver::Dftl => !matches!(effect, Effect::Bending | Effect::Twist),
         }
     }
 }

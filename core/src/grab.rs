@@ -1,4 +1,6 @@
-//! Grabs: a node pinned to a moving target, for user interaction (a haptic tool holding hair).
+//! Grabs: a node held at a moving target, for user interaction (a haptic tool holding hair):
+//! pinned to it (prescribed, Kmoch 2009 Sec. 8.1), or pulled toward it by a virtual coupling
+//! ([`Coupling`]).
 
 use crate::math::{Real, Vec3};
 
@@ -16,7 +18,51 @@ pub enum GrabStatus {
     Released,
 }
 
-/// A node pinned to a target that the caller moves each tick.
+/// A virtual coupling between a haptic device and the node it holds (Colgate, Stanley and
+/// Brown 1995; Adams and Hannaford 1999): a spring of `stiffness` and a damper of `damping`
+/// between the grab's target (the device) and the node, integrated implicitly with the strand
+/// (the node's effective mass in the constraint projection is `m + K Δt² + B Δt`), so a step
+/// is stable for every value in the ranges below, however light the node (a hair node weighs
+/// about 6.5e-8 kg: `K Δt²/m` is in the thousands).
+///
+/// The force reported is the coupling's, `K (x − target) + B (v − v_target)` on the device,
+/// and a coupled grab slips only on its force limit, never on reach: pulling a strand taut is
+/// the normal case. `docs/haptics.md` says how to choose `K` and `B` from a device's own
+/// damping, the loop's rate and the force gain an application applies (a device renders the
+/// gain times `K` and `B`; sampled at `T` it stays passive while `b > gain·K·T/2 + gain·B`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Coupling {
+    /// Spring stiffness `K`, N/m, in [`Coupling::STIFFNESS`].
+    pub stiffness: Real,
+    /// Damping `B`, N·s/m, in [`Coupling::DAMPING`].
+    pub damping: Real,
+}
+
+impl Coupling {
+    /// The stiffnesses a coupling accepts, N/m: from a spring no stiffer than the air's drag
+    /// on a strand to ten times the stiffest desk-top haptic device's (about 1e4 N/m).
+    pub const STIFFNESS: (Real, Real) = (1.0e-3, 1.0e5);
+    /// The dampings a coupling accepts, N·s/m (0: a spring alone).
+    pub const DAMPING: (Real, Real) = (0.0, 1.0e3);
+
+    /// A spring of `stiffness` N/m and a damper of `damping` N·s/m.
+    #[must_use]
+    pub const fn new(stiffness: Real, damping: Real) -> Coupling {
+        Coupling { stiffness, damping }
+    }
+
+    /// Whether both values lie in their ranges (NaN does not).
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        let (k_low, k_high) = Self::STIFFNESS;
+        let (b_low, b_high) = Self::DAMPING;
+        (k_low..=k_high).contains(&self.stiffness) && (b_low..=b_high).contains(&self.damping)
+    }
+}
+
+/// A node held at a target that the caller moves each tick: pinned to it, or pulled toward
+/// it by a [`Coupling`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Grab {
     /// Index of the strand in the world.
@@ -29,6 +75,12 @@ pub struct Grab {
     pub force_limit: Real,
     /// Held, slipped or released.
     pub status: GrabStatus,
+    /// `None`: the node is prescribed at the target (it follows the target exactly and slips
+    /// when the target leaves the strand's reach); `Some`: a virtual coupling pulls it there.
+    pub coupling: Option<Coupling>,
+    /// The target the last step ended with (at first, the target): a coupling's damper acts
+    /// on the node's velocity relative to the target's, `(target − previous_target)/Δt`.
+    pub previous_target: Vec3,
 }
 
 #[cfg(feature = "defmt")]
@@ -36,18 +88,20 @@ impl defmt::Format for Grab {
     fn format(&self, f: defmt::Formatter) {
         defmt::write!(
             f,
-            "Grab {{ strand: {}, node: {}, target: {}, force_limit: {}, status: {} }}",
+            "Grab {{ strand: {}, node: {}, target: {}, force_limit: {}, status: {}, coupling: {} }}",
             self.strand,
             self.node,
             crate::math::DefmtVec3(self.target),
             self.force_limit,
-            self.status
+            self.status,
+            self.coupling
         )
     }
 }
 
 impl Grab {
-    /// A grab of `node` on `strand`, held at `target`, slipping above `force_limit` newtons.
+    /// A grab of `node` on `strand`, prescribed at `target`, slipping above `force_limit`
+    /// newtons.
     #[must_use]
     pub const fn new(strand: u32, node: u32, target: Vec3, force_limit: Real) -> Grab {
         Grab {
@@ -56,7 +110,24 @@ impl Grab {
             target,
             force_limit,
             status: GrabStatus::Held,
+            coupling: None,
+            previous_target: target,
         }
+    }
+
+    /// The same grab pulled toward its target by `coupling` instead of prescribed there.
+    #[must_use]
+    pub const fn with_coupling(self, coupling: Coupling) -> Grab {
+        Grab {
+            coupling: Some(coupling),
+            ..self
+        }
+    }
+
+    /// Whether a coupling pulls the node (rather than the node being prescribed).
+    #[must_use]
+    pub const fn is_coupled(&self) -> bool {
+        self.coupling.is_some()
     }
 }
 
@@ -147,6 +218,46 @@ pub fn grabbed_nodes(
     held
 }
 
+/// After a strand's step was undone (the guard rolled it back to its last good state, at
+/// rest): the forces its grabs' devices feel are those of that state. A prescribed grab feels
+/// none (the step did not happen, and what a diverging step computed is no force a device
+/// should render); a coupled grab feels its coupling, `K (x − T) + B (v − v_T)`, stretched from
+/// the node where it was left. (A slip the step caused stands: a grab that let go of a
+/// diverging strand is safe.)
+pub fn forces_after_roll_back<const N: usize>(
+    ctx: &crate::context::StepContext,
+    grabs: &[Grab],
+    (strand, strand_index): (&crate::strand::Strand<N>, u32),
+    report: &mut crate::report::StepReport,
+) {
+    let nodes = strand.rest.nodes.min(N);
+    for (g, node) in grabbed_nodes(ctx, grabs, strand_index, nodes).iter() {
+        let (Some(grab), Some(force)) = (grabs.get(g), report.grab_forces.get_mut(g)) else {
+            continue;
+        };
+        *force = match (grab.coupling, strand.state.position.get(node)) {
+            (Some(c), Some(&x)) => {
+                let v = strand
+                    .state
+                    .velocity
+                    .get(node)
+                    .copied()
+                    .unwrap_or(Vec3::ZERO);
+                coupling_force(&c, x, v, grab, ctx.inv_dt)
+            }
+            _ => Vec3::ZERO,
+        };
+    }
+}
+
+/// The force a coupling's device feels with its node at `x`, moving at `v`:
+/// `K (x − T) + B (v − v_T)`, `v_T = (T − T_prev)/Δt` (`inv_dt` = `1/Δt`).
+#[must_use]
+pub fn coupling_force(c: &Coupling, x: Vec3, v: Vec3, grab: &Grab, inv_dt: Real) -> Vec3 {
+    let target_velocity = (grab.target - grab.previous_target) * inv_dt;
+    (x - grab.target) * c.stiffness + (v - target_velocity) * c.damping
+}
+
 /// Moves `grab`'s target to `target` if it is finite (the caller's input: a non-finite
 /// target is ignored). Returns whether it moved.
 pub fn retarget(grab: &mut Grab, target: Vec3) -> bool {
@@ -158,20 +269,24 @@ pub fn retarget(grab: &mut Grab, target: Vec3) -> bool {
     }
 }
 
-/// After a step: every grab whose bit is set in `report.grabs_slipped` stops holding its node.
+/// After a step: every grab whose bit is set in `report.grabs_slipped` stops holding its node,
+/// and every grab remembers the target the step ended with (its coupling's damper measures
+/// the target's velocity from it).
 pub fn apply_slips(grabs: &mut [Grab], report: &crate::report::StepReport) {
-    for (g, grab) in grabs.iter_mut().enumerate().take(MAX_GRABS) {
-        if report.grabs_slipped & (1 << g) != 0 {
+    for (g, grab) in grabs.iter_mut().enumerate() {
+        if g < MAX_GRABS && report.grabs_slipped & (1 << g) != 0 {
             grab.status = GrabStatus::Slipped;
         }
+        grab.previous_target = grab.target;
     }
 }
 
 /// Slack allowed on a grab's reach: the projection's stretch bound (issue 4: 0.1 %).
 pub const REACH_SLACK: Real = 1.0e-3;
 
-/// Before a step: a held grab whose target no inextensible strand can reach slips at once,
-/// and its bit is set in `report.grabs_slipped`.
+/// Before a step: a held, prescribed grab whose target no inextensible strand can reach slips
+/// at once, and its bit is set in `report.grabs_slipped`. A coupled grab never slips on reach:
+/// its node stays on the strand and the coupling's spring stretches instead.
 ///
 /// Holding it would take an unbounded force: the projection, asked for positions that do
 /// not exist (prescribed nodes carry no rows), stretches and kinks the strand
@@ -228,8 +343,8 @@ pub fn slip_unreachable<const N: usize>(
     report.grabs_slipped |= out_of_reach;
 }
 
-/// Grab `g` if it holds a node of one of `strands`: the strand's rest data, its rest node 1,
-/// the grabbed node and the target.
+/// Grab `g` if it prescribes a node of one of `strands`: the strand's rest data, its rest
+/// node 1, the grabbed node and the target.
 fn held<'a, const N: usize>(
     grabs: &[Grab],
     g: usize,
@@ -240,6 +355,7 @@ fn held<'a, const N: usize>(
     let strand = strands.get(grab.strand.checked_sub(first_strand)? as usize)?;
     let node = grab.node as usize;
     let usable = grab.status == GrabStatus::Held
+        && !grab.is_coupled()
         && (2..strand.nodes()).contains(&node)
         && crate::math::is_finite(grab.target);
     let root = *strand.rest.position.get(1)?;

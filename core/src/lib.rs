@@ -53,11 +53,11 @@ pub mod world;
 pub use collide::{Collider, Shape};
 pub use effects::{Effect, Effects, Solver};
 pub use error::{BuildError, CapacityError, Error, ParamError};
-pub use grab::{Grab, GrabStatus};
+pub use grab::{Coupling, Grab, GrabStatus};
 pub use head::{Pose, Shake};
 pub use math::{DefaultMath, Libm, Math, Quat, Real, Vec3};
 pub use params::{DftlCoefficients, DftlParams, Mode, Params, WindParams};
-pub use pipeline::dftl::step_blocks;
+pub use pipeline::dftl::{step_blocks, step_strands_in_blocks};
 pub use pipeline::rod::RodScratch;
 pub use pipeline::rod_lanes::RodBlockScratch;
 pub use pipeline::{

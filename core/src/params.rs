@@ -452,17 +452,6 @@ mod tests {
             ..Params::DEFAULT
         };
         assert_eq!(dftl.validate(), Ok(()));
-        let grabs_on_dftl = Params {
-            effects: Effects::NONE.with(Effect::Grabs),
-            ..dftl
-        };
-        assert!(matches!(
-            grabs_on_dftl.validate(),
-            Err(ParamError::UnsupportedEffect {
-                effect: "grabs",
-                ..
-            })
-        ));
         let sideways = Params {
             wind: WindParams {
                 direction: Vec3::new(1.0, 1.0, 0.0),
@@ -490,6 +479,30 @@ mod tests {
             shape_on_rod.validate(),
             Err(ParamError::UnsupportedEffect {
                 effect: "shape",
+                ..
+            })
+        ));
+    }
+
+    #[test]
+    fn dftl_takes_grabs_and_refuses_the_rod_s_energies() {
+        let dftl = Params {
+            solver: Solver::Dftl,
+            ..Params::DEFAULT
+        };
+        let grabs_on_dftl = Params {
+            effects: Effects::NONE.with(Effect::Grabs),
+            ..dftl
+        };
+        assert_eq!(grabs_on_dftl.validate(), Ok(()));
+        let twist_on_dftl = Params {
+            effects: Effects::NONE.with(Effect::Twist),
+            ..dftl
+        };
+        assert!(matches!(
+            twist_on_dftl.validate(),
+            Err(ParamError::UnsupportedEffect {
+                effect: "twist",
                 ..
             })
         ));

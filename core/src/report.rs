@@ -143,6 +143,15 @@ pub struct StepReport {
     pub grab_forces: [Vec3; MAX_GRABS],
     /// Grabs that slipped this step (bit `g` for grab `g`).
     pub grabs_slipped: u8,
+    /// Force the head feels from the strands, N, summed over strands: what the held root
+    /// nodes 0 and 1 of every strand transmit (a device may hold the head too). At rest, with
+    /// the grabs' forces, the weight of nodes 2 to the last. The colliders' contact forces
+    /// are apart, in `collider_forces` (a head that carries colliders feels those too). The
+    /// rod: the elastic forces on nodes 0 and 1 and segment 1's constraint force on node 1;
+    /// DFTL, which has no such forces (its corrections are one-sided): the change of the
+    /// strand's momentum that no external force, collider or grab explains
+    /// (`docs/architecture.md`, "Forces on the head and the grabs").
+    pub head_force: Vec3,
     /// Total contact force the hair exerts on each collider, N (from the collision multipliers).
     pub collider_forces: [Vec3; MAX_COLLIDERS],
     /// Every stage this step counted ([`StepReport::ran_on`]), in call order: recorded in the
@@ -192,6 +201,7 @@ impl Default for StepReport {
             rolled_back_strands: heapless::Vec::new(),
             grab_forces: [Vec3::ZERO; MAX_GRABS],
             grabs_slipped: 0,
+            head_force: Vec3::ZERO,
             collider_forces: [Vec3::ZERO; MAX_COLLIDERS],
             trace: StageTrace::new(),
         }
@@ -274,6 +284,7 @@ impl StepReport {
             *a += b;
         }
         self.grabs_slipped |= other.grabs_slipped;
+        self.head_force += other.head_force;
         for (a, b) in self.collider_forces.iter_mut().zip(other.collider_forces) {
             *a += b;
         }

@@ -133,3 +133,12 @@ pub fn carry_root_frame<M: Math, const N: usize>(
     state.theta[0] = unwrap_near(angle, state.theta[0]);
     state.root_frame = u;
 }
+
+/// The elastic forces the hair exerts on the held nodes 0 and 1 (Kmoch Sec. 7.2's `F_0 + F_1`,
+/// which root coupling overrides): the rod's share of what a strand transmits to the head
+/// besides its constraint force on node 1. One strand or lanes (`P::V`).
+#[inline(always)]
+#[must_use]
+pub fn elastic_on_root<P: crate::precision::Kernel, const N: usize>(forces: &[P::V; N]) -> P::V {
+    forces[0] + forces[1]
+}

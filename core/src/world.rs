@@ -39,6 +39,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     grabs: heapless::Vec<Grab, MAX_GRABS>,
     head: Pose,
     steps: u64,
+    /// A grab target given since the last step was not finite (and was ignored): the next
+    /// step's report flags it.
+    bad_target: bool,
     /// The rod step's scratch space: built here once, never per step (not state: not hashed,
     /// snapshotted or cloned).
     scratch: RodScratch<M, N>,
@@ -63,6 +66,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             grabs: heapless::Vec::new(),
             head: Pose::IDENTITY,
             steps: 0,
+            bad_target: false,
             scratch: RodScratch::new(),
             math: PhantomData,
         }
@@ -129,16 +133,29 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             }
             .into());
         }
+        if grab.coupling.is_some_and(|c| !c.is_valid()) {
+            return Err(ParamError::OutOfRange {
+                field: "grab.coupling",
+                allowed: "stiffness 1e-3 to 1e5 N/m, damping 0 to 1e3 N·s/m",
+            }
+            .into());
+        }
+        let grab = Grab {
+            previous_target: grab.target,
+            ..grab
+        };
         self.grabs.push(grab).map_err(|_| CapacityError::Grabs {
             capacity: MAX_GRABS,
         })?;
         Ok(self.grabs.len() - 1)
     }
 
-    /// Moves grab `grab`'s target (ignored for an unknown index or a non-finite target).
+    /// Moves grab `grab`'s target (ignored for an unknown index; a non-finite target is
+    /// ignored, the grab keeps its target, and the next step's report flags
+    /// [`crate::Flags::BAD_INPUT`]).
     pub fn set_grab_target(&mut self, grab: usize, target: Vec3) {
         if let Some(g) = self.grabs.get_mut(grab) {
-            retarget(g, target);
+            self.bad_target |= !retarget(g, target);
         }
     }
 
@@ -195,6 +212,9 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// back and named).
     pub fn step(&mut self, input: &StepInput<'_>) -> StepReport {
         let mut report = StepReport::default();
+        if core::mem::take(&mut self.bad_target) {
+            report.flags.insert(crate::report::Flags::BAD_INPUT);
+        }
         let world = Stepping {
             params: &self.params,
             dftl: self.dftl,

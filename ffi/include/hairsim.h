@@ -34,7 +34,7 @@
 /** Node capacity per strand (HAIRSIM_NODES when the library was built). */
 #define HAIRSIM_NODES 16
 /** Bytes of a world buffer: measured on a 64-bit host, no fewer than a 32-bit target needs. */
-#define HAIRSIM_WORLD_SIZE 14576
+#define HAIRSIM_WORLD_SIZE 14720
 /** Alignment of a world buffer, bytes. */
 #define HAIRSIM_WORLD_ALIGN 8
 /**
@@ -66,7 +66,7 @@
 /**
  * The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
  */
-#define HAIRSIM_VERSION_MINOR 2
+#define HAIRSIM_VERSION_MINOR 3
 
 /**
  * The library's patch version: changes that no header sees (fixes, speed).
@@ -140,7 +140,7 @@
 #define HAIRSIM_EFFECT_WIND (1 << 7)
 
 /**
- * Nodes held by grabs (rod solver only).
+ * Nodes held by grabs, prescribed or through a virtual coupling (both solvers).
  */
 #define HAIRSIM_EFFECT_GRABS (1 << 8)
 
@@ -262,7 +262,8 @@ enum hairsim_error
    */
   HAIRSIM_ERROR_INVALID_COLLIDER = 17,
   /**
-   * A grab names no strand, a node outside 2 to the strand's last, or a force limit <= 0.
+   * A grab names no strand, a node outside 2 to the strand's last, a force limit <= 0, or
+   * a coupling out of range.
    */
   HAIRSIM_ERROR_INVALID_GRAB = 18,
   /**
@@ -618,6 +619,16 @@ typedef struct hairsim_grab {
    * Largest force the grab transmits before it slips, N (> 0).
    */
   float force_limit;
+  /**
+   * A virtual coupling's spring, N/m: 0 (with `damping` 0) holds the node at the target
+   * (it slips when the target leaves the strand's reach); from 1e-3 to 1e5, a spring and a
+   * damper pull the node toward the target (it slips only past `force_limit`).
+   */
+  float stiffness;
+  /**
+   * The coupling's damper, N·s/m, from 0 to 1e3 (0 without a coupling).
+   */
+  float damping;
 } hairsim_grab;
 
 /**
@@ -744,9 +755,15 @@ typedef struct hairsim_step_report {
    */
   float max_penetration;
   /**
-   * Force each grab's device feels, N (zero for unused slots).
+   * Force each grab's device feels, N (zero for unused slots): a coupled grab's is its
+   * coupling's.
    */
   struct hairsim_vec3 grab_forces[HAIRSIM_MAX_GRABS];
+  /**
+   * Force the head feels from the strands' held roots (nodes 0 and 1), N, summed: with the
+   * grabs' forces, the hair's weight at rest (the colliders' are in `collider_forces`).
+   */
+  struct hairsim_vec3 head_force;
   /**
    * Total contact force the hair exerts on each collider, N.
    */

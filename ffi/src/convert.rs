@@ -382,6 +382,7 @@ pub(crate) fn report_to_c(r: &StepReport) -> hairsim_step_report {
         max_contact_stretch: r.max_contact_stretch,
         max_penetration: r.max_penetration,
         grab_forces: [hairsim_vec3::default(); HAIRSIM_MAX_GRABS],
+        head_force: vec3_to_c(r.head_force),
         collider_forces: [hairsim_vec3::default(); HAIRSIM_MAX_COLLIDERS],
         stage_runs: r.stage_runs,
     };

@@ -46,7 +46,9 @@ use core::mem::{align_of, size_of};
 use core::ptr::{self, addr_of, addr_of_mut};
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use hairsim_core::{DefaultMath, Grab, Material, Math, Params, StepInput, Strand, Vec3, World};
+use hairsim_core::{
+    Coupling, DefaultMath, Grab, Material, Math, Params, StepInput, Strand, Vec3, World,
+};
 
 use convert::Result;
 pub use types::*;
@@ -525,11 +527,17 @@ pub unsafe extern "C" fn hairsim_add_grab(
         Ok(t) => t,
         Err(e) => return e,
     };
-    if !grab.force_limit.is_finite() {
+    if !(grab.force_limit.is_finite() && grab.stiffness.is_finite() && grab.damping.is_finite()) {
         return hairsim_error::NotFinite;
     }
+    let held = Grab::new(grab.strand, grab.node, target, grab.force_limit);
+    let held = if grab.stiffness == 0.0 && grab.damping == 0.0 {
+        held
+    } else {
+        held.with_coupling(Coupling::new(grab.stiffness, grab.damping))
+    };
     let add = |w: &mut SimWorld| {
-        w.add_grab(Grab::new(grab.strand, grab.node, target, grab.force_limit))
+        w.add_grab(held)
             .map_err(|e| convert::add_error(e, hairsim_error::InvalidGrab))
     };
     // SAFETY: the caller's promise for `world`.

@@ -80,6 +80,8 @@ impl Scene {
                     node: g.node,
                     target: convert::vec3_to_c(g.target),
                     force_limit: g.force_limit,
+                    stiffness: g.coupling.map_or(0.0, |c| c.stiffness),
+                    damping: g.coupling.map_or(0.0, |c| c.damping),
                 })
                 .collect(),
             circles: world
@@ -324,9 +326,19 @@ pub(crate) fn generate(scene: &Scene) -> String {
     )
     .unwrap();
     for g in &scene.grabs {
+        // A prescribed grab leaves the coupling's fields at their zero.
+        let coupling = if g.stiffness == 0.0 && g.damping == 0.0 {
+            String::new()
+        } else {
+            format!(
+                ", .stiffness = {}, .damping = {}",
+                scalar(g.stiffness),
+                scalar(g.damping)
+            )
+        };
         writeln!(
             w,
-            "    {{.strand = {}, .node = {}, .target = {}, .force_limit = {}}},",
+            "    {{.strand = {}, .node = {}, .target = {}, .force_limit = {}{coupling}}},",
             g.strand,
             g.node,
             vec3(g.target),

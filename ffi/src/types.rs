@@ -12,7 +12,7 @@
 /// when the ABI breaks and the minor version when it only grows.
 pub const HAIRSIM_VERSION_MAJOR: u32 = 0;
 /// The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
-pub const HAIRSIM_VERSION_MINOR: u32 = 2;
+pub const HAIRSIM_VERSION_MINOR: u32 = 3;
 /// The library's patch version: changes that no header sees (fixes, speed).
 pub const HAIRSIM_VERSION_PATCH: u32 = 0;
 /// The three parts in one word, `0x00MMmmpp`, as `hairsim_version()` returns it; the header's
@@ -72,7 +72,7 @@ pub const HAIRSIM_EFFECT_COLLISIONS: u32 = 1 << 5;
 pub const HAIRSIM_EFFECT_SHAPE: u32 = 1 << 6;
 /// Wind as an external acceleration.
 pub const HAIRSIM_EFFECT_WIND: u32 = 1 << 7;
-/// Nodes held by grabs (rod solver only).
+/// Nodes held by grabs, prescribed or through a virtual coupling (both solvers).
 pub const HAIRSIM_EFFECT_GRABS: u32 = 1 << 8;
 /// Hair-hair interaction: accelerations the caller computes and passes to `hairsim_step`.
 pub const HAIRSIM_EFFECT_HAIR_HAIR: u32 = 1 << 9;
@@ -132,7 +132,8 @@ pub enum hairsim_error {
     GrabsFull = 16,
     /// A collider's geometry is out of range (radius, unit plane normal).
     InvalidCollider = 17,
-    /// A grab names no strand, a node outside 2 to the strand's last, or a force limit <= 0.
+    /// A grab names no strand, a node outside 2 to the strand's last, a force limit <= 0, or
+    /// a coupling out of range.
     InvalidGrab = 18,
     /// An argument's buffer overlaps the world's.
     Overlap = 19,
@@ -365,6 +366,12 @@ pub struct hairsim_grab {
     pub target: hairsim_vec3,
     /// Largest force the grab transmits before it slips, N (> 0).
     pub force_limit: f32,
+    /// A virtual coupling's spring, N/m: 0 (with `damping` 0) holds the node at the target
+    /// (it slips when the target leaves the strand's reach); from 1e-3 to 1e5, a spring and a
+    /// damper pull the node toward the target (it slips only past `force_limit`).
+    pub stiffness: f32,
+    /// The coupling's damper, N·s/m, from 0 to 1e3 (0 without a coupling).
+    pub damping: f32,
 }
 
 /// What one step takes.
@@ -416,8 +423,12 @@ pub struct hairsim_step_report {
     pub max_contact_stretch: f32,
     /// Deepest node inside a collider after the step, m.
     pub max_penetration: f32,
-    /// Force each grab's device feels, N (zero for unused slots).
+    /// Force each grab's device feels, N (zero for unused slots): a coupled grab's is its
+    /// coupling's.
     pub grab_forces: [hairsim_vec3; HAIRSIM_MAX_GRABS],
+    /// Force the head feels from the strands' held roots (nodes 0 and 1), N, summed: with the
+    /// grabs' forces, the hair's weight at rest (the colliders' are in `collider_forces`).
+    pub head_force: hairsim_vec3,
     /// Total contact force the hair exerts on each collider, N.
     pub collider_forces: [hairsim_vec3; HAIRSIM_MAX_COLLIDERS],
     /// How many strands each stage ran on, in the core's stage order.

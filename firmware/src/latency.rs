@@ -1,6 +1,7 @@
 //! Bounded latency, measured on the target: SysTick ticks per step of rod and DFTL scenes of
 //! growing size, calm (head still, hair hanging) and violent (head shaking at 10 rad/s, hair
-//! starting horizontal), in fixed-cost mode.
+//! starting horizontal), in fixed-cost mode; and of the haptic DFTL scene, a device holding a
+//! strand through a virtual coupling.
 //!
 //! Under `qemu-system-arm -icount shift=0` every instruction takes 1 ns of virtual time and
 //! SysTick counts the 25 MHz system clock, so one tick is 40 instructions: a deterministic
@@ -19,7 +20,7 @@ const STEPS: usize = 200;
 /// Steps per run when profiling one scene (a QEMU execution trace grows by ~7 MB per step).
 const PROFILE_STEPS: usize = 6;
 
-/// Set at build time (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape|draped|draped_clear cargo build
+/// Set at build time (`HAIRSIM_PROFILE=rod|dftl|dftl_noshape|draped|draped_clear|haptic_dftl cargo build
 /// --release`): run only that scene, with [`step_begins`] and [`step_ends`] around each step,
 /// for `firmware/profile.py` to read a QEMU execution trace by (README, "Measured on the
 /// target"): the 128-node rod or the 512-vertex DFTL one for [`PROFILE_STEPS`] steps calm and
@@ -291,7 +292,57 @@ fn add_draped<const S: usize, const N: usize, M: Math>(
     }
 }
 
+/// The haptic DFTL scene (`hairsim_core::scenes::haptic_dftl`), [`STEPS`] steps as it runs
+/// (violent: the head shaking at 10 rad/s, the device going round its circle) and with the head
+/// and the device still (calm): prints a `latency haptic-dftl …` line.
+fn measure_haptic_dftl<M: Math>(world: &mut HapticWorld<M>, steps: usize) {
+    use hairsim_core::scenes::haptic_dftl;
+    let mut line = [(0u32, 0u32, 0u32); 2];
+    for (v, violent) in [false, true].into_iter().enumerate() {
+        *world = World::new();
+        if haptic_dftl::build(world).is_err() {
+            return hprintln!("latency error: cannot build the haptic-dftl scene");
+        }
+        // SAFETY: the only access to TICKS: single-threaded, no interrupt touches it.
+        let all = unsafe { &mut *core::ptr::addr_of_mut!(TICKS) };
+        let all = &mut all[..steps.clamp(1, STEPS)];
+        for (k, slot) in all.iter_mut().enumerate() {
+            let k = k as u32;
+            *slot = ticks(|| {
+                step_begins();
+                if violent {
+                    haptic_dftl::step(world, k);
+                } else {
+                    world.step(&StepInput {
+                        head: Pose::IDENTITY,
+                        accelerations: None,
+                    });
+                }
+                step_ends();
+            });
+        }
+        line[v] = stats(all);
+    }
+    hprintln!(
+        "latency haptic-dftl strands {} nodes {} calm {} {} {} violent {} {} {}",
+        haptic_dftl::STRANDS,
+        haptic_dftl::STRANDS * haptic_dftl::NODES,
+        line[0].0,
+        line[0].1,
+        line[0].2,
+        line[1].0,
+        line[1].1,
+        line[1].2
+    );
+}
+
 type RodWorld<M> = World<8, 32, M>;
+/// The haptic DFTL scene's world.
+type HapticWorld<M> = World<
+    { hairsim_core::scenes::haptic_dftl::STRANDS },
+    { hairsim_core::scenes::haptic_dftl::NODES },
+    M,
+>;
 /// A world sized for one 16-node strand (the step's scratch arrays scale with the capacity).
 type SmallRodWorld<M> = World<1, 16, M>;
 type DftlWorld<M> = World<64, 16, M>;
@@ -299,6 +350,7 @@ type DftlWorld<M> = World<64, 16, M>;
 static mut ROD: RodWorld<crate::Vsqrt> = World::new();
 static mut SMALL_ROD: SmallRodWorld<crate::Vsqrt> = World::new();
 static mut DFTL: DftlWorld<crate::Vsqrt> = World::new();
+static mut HAPTIC: HapticWorld<crate::Vsqrt> = World::new();
 
 /// Runs every measurement: rod 16–256 nodes, DFTL 64–1024 vertices with and without shape
 /// preservation (`dftl`, `dftl_noshape`); or, when built with [`PROFILE`], that one scene.
@@ -307,6 +359,7 @@ pub fn run() {
     let small = unsafe { &mut *core::ptr::addr_of_mut!(SMALL_ROD) };
     let rod = unsafe { &mut *core::ptr::addr_of_mut!(ROD) };
     let dftl = unsafe { &mut *core::ptr::addr_of_mut!(DFTL) };
+    let haptic = unsafe { &mut *core::ptr::addr_of_mut!(HAPTIC) };
     match PROFILE {
         None => {}
         Some("rod") => return measure(rod, Solver::Rod, (4, 32), false, PROFILE_STEPS),
@@ -320,9 +373,10 @@ pub fn run() {
             let _ = collision_scene(rod, (32, STEPS), (true, scene == "draped"));
             return;
         }
+        Some("haptic_dftl") => return measure_haptic_dftl(haptic, PROFILE_STEPS),
         Some(other) => {
             return hprintln!(
-                "latency error: HAIRSIM_PROFILE={} (rod, dftl, dftl_noshape, draped, draped_clear)",
+                "latency error: HAIRSIM_PROFILE={} (rod, dftl, dftl_noshape, draped, draped_clear, haptic_dftl)",
                 other
             );
         }
@@ -341,4 +395,5 @@ pub fn run() {
     for strands in [4, 8, 16, 32, 64] {
         measure(dftl, Solver::Dftl, (strands, 16), false, STEPS);
     }
+    measure_haptic_dftl(haptic, STEPS);
 }

@@ -108,7 +108,7 @@ enum Call {
     Configure(WorldArg, Option<ParamsArg>),
     AddStrand(WorldArg, Points, MaterialArg, Out),
     AddCollider(WorldArg, Option<(u32, u32, [F; 7])>, Out),
-    AddGrab(WorldArg, Option<(u32, u32, [F; 4])>, Out),
+    AddGrab(WorldArg, Option<(u32, u32, [F; 6])>, Out),
     ReleaseGrab(WorldArg, u32),
     Step {
         world: WorldArg,
@@ -423,6 +423,8 @@ unsafe fn call_one(call: &Call, worlds: &mut Worlds, out: &mut OutBuf) -> hairsi
                         node: *node % 40,
                         target: vec3([f[0], f[1], f[2]]),
                         force_limit: f[3].get(),
+                        stiffness: f[4].get(),
+                        damping: f[5].get(),
                     });
                     hairsim_add_grab(world, &*g, index)
                 }

@@ -15,6 +15,7 @@ pub use hairsim_files::{builtin, hairfile, hairscene, scene};
 pub mod cmd;
 pub mod export;
 pub mod groom;
+pub mod haptic;
 pub mod output;
 pub mod picture;
 pub mod record;

@@ -7,7 +7,7 @@
 //! and in between the harness adds SPH's accelerations and steps the blocks. The Kirchhoff rod
 //! steps each strand with [`hairsim_core::step_strands`]. DFTL steps each block as
 //! structure-of-arrays [`DftlBlock`]s of [`RECOMMENDED_LANES`] strands
-//! ([`hairsim_core::step_blocks`]: the same bits as the per-strand path, several times
+//! ([`hairsim_core::step_strands_in_blocks`]: the same bits as the per-strand path, several times
 //! faster): the blocks keep the rest data, loaded once; every step copies the state in from
 //! the strands, steps, and copies it back while it is still in cache, so `strands` stays the
 //! state anyone reads or writes.
@@ -18,8 +18,8 @@ use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::step_strands_with;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
-    step_blocks, step_strands, step_strands_in_lanes_with, Collider, Grab, Math, Params, Pose,
-    Real, RodBlockScratch, RodScratch, Solver, Stage, StepReport, Strand, Vec3,
+    step_strands, step_strands_in_blocks, step_strands_in_lanes_with, Collider, Grab, Math, Params,
+    Pose, Real, RodBlockScratch, RodScratch, Solver, Stage, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -354,9 +354,10 @@ impl Blocks<'_> {
         }
     }
 
-    /// Every block of `strands` through the core's block pipeline (DFTL ignores grabs): each
-    /// block's state copied into its SoA blocks `soa`, stepped, and copied back while it is
-    /// still in cache.
+    /// Every block of `strands` through the core's block pipeline
+    /// ([`step_strands_in_blocks`]): each block's state copied into its SoA blocks `soa`,
+    /// stepped, and copied back while it is still in cache; the SoA blocks holding a strand a
+    /// grab holds step one strand at a time.
     fn soa<const N: usize, M: Math>(
         &self,
         strands: &mut [Strand<N>],
@@ -371,14 +372,10 @@ impl Blocks<'_> {
                     r: &mut StepReport| {
             *r = StepReport::default();
             let acc = self.of_block::<N>(b, strands.len());
-            for (lanes, chunk) in blocks.iter_mut().zip(strands.chunks(LANES)) {
-                load_state(lanes, chunk);
-            }
-            let first = (b * self.block) as u32;
-            step_blocks::<VectorSqrt<M>, LANES, N>(self.ctx, blocks, first, acc, r);
-            for (lanes, chunk) in blocks.iter().zip(strands.chunks_mut(LANES)) {
-                lanes.store(chunk);
-            }
+            let at = ((b * self.block) as u32, self.grabs);
+            step_strands_in_blocks::<VectorSqrt<M>, LANES, N>(
+                self.ctx, blocks, strands, at, acc, r,
+            );
         };
         match parallel {
             Some(pool) => pool.install(|| {
@@ -396,25 +393,6 @@ impl Blocks<'_> {
                 for (b, ((strands, blocks), r)) in blocks.zip(reports.iter_mut()).enumerate() {
                     step(b, strands, blocks, r);
                 }
-            }
-        }
-    }
-}
-
-/// Copies the state (positions, velocities) of `strands` into the lanes of `block` they were
-/// loaded into (lane `l` from `strands[l]`): the inverse of [`DftlBlock::store`]. The rest
-/// data stays as loaded.
-fn load_state<const N: usize>(block: &mut DftlBlock<LANES, N>, strands: &[Strand<N>]) {
-    for (l, strand) in strands.iter().enumerate().take(block.strands.min(LANES)) {
-        let n = block.nodes[l].min(N);
-        for (lanes, (x, v)) in block.state.iter_mut().zip(
-            strand.state.position[..n]
-                .iter()
-                .zip(&strand.state.velocity[..n]),
-        ) {
-            for (axis, (p, u)) in x.to_array().into_iter().zip(v.to_array()).enumerate() {
-                lanes.position[axis][l] = p;
-                lanes.velocity[axis][l] = u;
             }
         }
     }

@@ -186,6 +186,19 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
         block
     }
 
+    /// Copies the state (positions, velocities) of `strands` into the lanes they were built
+    /// from (lane `l` from `strands[l]`): the inverse of [`Self::store`]. The rest data stays as
+    /// it was built.
+    pub fn load_state(&mut self, strands: &[Strand<N>]) {
+        for (l, strand) in strands.iter().enumerate().take(self.strands.min(W)) {
+            let n = self.nodes[l].min(strand.rest.nodes).min(N);
+            for k in 0..n {
+                set(&mut self.state[k].position, l, strand.state.position[k]);
+                set(&mut self.state[k].velocity, l, strand.state.velocity[k]);
+            }
+        }
+    }
+
     /// Writes the block's state (positions, velocities) back into `strands`, lane `l` into
     /// `strands[l]`; the strands must be the ones loaded, in order.
     pub fn store(&self, strands: &mut [Strand<N>]) {

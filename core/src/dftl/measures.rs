@@ -35,6 +35,30 @@ pub struct Measures<T> {
 /// `Σ m Δx^push` per collider (the push-outs, mass weighted), per lane.
 pub type ColliderPush<T> = [V3<T>; MAX_COLLIDERS];
 
+/// A strand's free nodes' momenta over a step, per lane, summed in node order as the pass goes
+/// (each node's terms where the pass has them in registers, `pipeline::dftl`): what the head
+/// transmits is the difference ([`Tally::head_force`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Momenta<T: Lane> {
+    /// `Σ m (v + a Δt)`: at the step's end under the external forces alone (the nodes'
+    /// `Advanced::kicked`).
+    pub external: V3<T>,
+    /// `Σ m v⁺`: after the pass.
+    pub after: V3<T>,
+}
+
+impl<T: Lane> Momenta<T> {
+    /// Before the first node.
+    #[inline(always)]
+    #[must_use]
+    pub fn zero() -> Self {
+        Momenta {
+            external: V3::zero(),
+            after: V3::zero(),
+        }
+    }
+}
+
 impl<T: Lane> Default for Measures<T> {
     fn default() -> Self {
         let zero = T::splat(0.0);
@@ -144,21 +168,56 @@ pub struct Tally {
     pub contacts: u32,
     /// `Σ m Δx^push` per collider.
     pub collider_push: [Vec3; MAX_COLLIDERS],
+    /// `Σ m (v + a Δt)` over the free nodes ([`Momenta::external`]).
+    pub external: Vec3,
+    /// The force the head feels from the strand ([`Tally::head_force`]), N; the report takes
+    /// it after the guard, from strands that were not rolled back.
+    pub head_force: Vec3,
 }
 
 impl Tally {
     /// One strand's measures as the report gives them (a block builds its lanes' tallies
-    /// from [`Measures::stretches`] of all lanes at once).
+    /// from [`Measures::stretches`] of all lanes at once); `momenta` are the free nodes'
+    /// momenta over the pass ([`Momenta`]).
     #[must_use]
-    pub fn from_measures<M: Math>(m: &Measures<Real>, collider_push: &ColliderPush<Real>) -> Self {
+    pub fn from_measures<M: Math>(
+        m: &Measures<Real>,
+        collider_push: &ColliderPush<Real>,
+        momenta: Momenta<Real>,
+        inv_dt: Real,
+    ) -> Self {
         let (stretch, contact_stretch) = m.stretches::<M>();
+        let collider_push = collider_push.map(Vec3::from);
+        let (external, momentum) = (momenta.external.into(), momenta.after.into());
         Tally {
             stretch,
             contact_stretch,
             penetration: m.penetration,
             contacts: m.contacts as u32,
-            collider_push: collider_push.map(Vec3::from),
+            collider_push,
+            external,
+            head_force: Self::head_force(external, momentum, &collider_push, inv_dt),
         }
+    }
+
+    /// The force the head feels from one DFTL strand, N. DFTL moves nodes by one-sided
+    /// corrections (follow-the-leader, shape, the eq. 14 damping), so no constraint force can
+    /// be read off a node; what the held root nodes transmit is the change of the free
+    /// nodes' momentum that the external forces and the colliders do not explain, with the
+    /// opposite sign: `(Σ m (v + a Δt) − Σ m v⁺)/Δt + Σ m Δx^push/Δt²` (the colliders feel
+    /// `−Σ m Δx^push/Δt²`), `external` being the first sum and `momentum` the
+    /// second ([`Momenta`]). At rest: the weight the strand does not lay on a collider. It
+    /// counts the shape springs' pull (their targets move with the head) and the damping's;
+    /// the force a grab's device feels is subtracted by the caller where the strand is held.
+    #[must_use]
+    pub fn head_force(
+        external: Vec3,
+        momentum: Vec3,
+        collider_push: &[Vec3; MAX_COLLIDERS],
+        inv_dt: Real,
+    ) -> Vec3 {
+        let pushed = collider_push.iter().fold(Vec3::ZERO, |sum, &p| sum + p);
+        (external - momentum) * inv_dt + pushed * (inv_dt * inv_dt)
     }
 
     /// Folds the tally into `report`: maxima and counts, and each collider's contact force

@@ -25,17 +25,20 @@ use crate::capacities::MAX_COLLIDERS;
 use crate::collide::Shape;
 use crate::context::StepContext;
 use crate::dftl::block::{read_lanes, BlockState, DftlBlock};
-use crate::dftl::measures::{ColliderPush, Measures, Tally};
+use crate::dftl::measures::{ColliderPush, Measures, Momenta, Tally};
 use crate::dftl::node::{Advanced, Chain, NodeInput, Setup};
 use crate::dftl::velocity::Pending;
 use crate::dftl::{collisions, damping, follow_leader, frame, predict, shape};
+use crate::grab::{forces_after_roll_back, grabbed_nodes, Grab};
 use crate::guard::guard;
 use crate::lane::{component_sum, not_finite_sum, Lane, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
+use crate::params::{DftlCoefficients, Mode};
+use crate::projection::project_in_mode;
 use crate::report::{Stage, StepReport};
 use crate::root_coupling::root_coupling;
 use crate::snapshot::{snapshot, Positions};
-use crate::strand::{Strand, StrandState};
+use crate::strand::{RestStrand, Strand, StrandState};
 
 /// Calls `pass::<…, SHAPE, INEXTENSIBLE, DRAG>(…)` with the scene's three effect switches
 /// (`setup.shape`, `.inextensibility`, `.drag`) as constants: each copy of a pass then
@@ -57,17 +60,21 @@ macro_rules! with_effect_switches {
 
 /// Steps one strand by `ctx.dt` (SB15 Algorithm 1, local dynamics), `setup` being
 /// [`Setup::new`] of `ctx` (built once for all strands). `index` is the strand's index in the
-/// whole scene; `accelerations` (if any) are the caller's per-node accelerations for this
-/// strand, indexed by node. Never panics: a strand that writes a non-finite value is rolled
+/// whole scene (as in `Grab::strand`); `accelerations` (if any) are the caller's per-node
+/// accelerations for this strand, indexed by node. A strand that a grab holds this step takes
+/// [`step_held_strand`]. Never panics: a strand that writes a non-finite value is rolled
 /// back.
 pub fn step_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     setup: &Setup,
     ctx: &StepContext,
-    index: u32,
+    (grabs, index): (&[Grab], u32),
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
+    if !grabbed_nodes(ctx, grabs, index, strand.rest.nodes.min(N)).is_empty() {
+        return step_held_strand::<M, N>(strand, setup, ctx, (grabs, index), accelerations, report);
+    }
     // Quarantine: the last good positions.
     let last_good: Positions<N> = snapshot(strand, report);
     // Lines 12–15, fused into the pass below: external forces and the prediction.
@@ -77,10 +84,94 @@ pub fn step_strand<M: Math, const N: usize>(
     // Lines 16–27 in one pass from the root: shape, follow-the-leader, collisions, frames, and
     // the velocities one node behind.
     count_constraints(setup, 1, report);
-    let pass = strand_pass::<M, N>(setup, ctx, strand, accelerations, report);
+    let (pass, tally) = strand_pass::<M, N>(setup, ctx, strand, accelerations);
+    tally.report(report, ctx.colliders().len(), setup.inv_dt);
     // Quarantine: every value written finite, or the last good positions back.
     let good = not_finite_sum(roots + pass) == 0.0;
-    guard(strand, &last_good, |_, _| good, index, report);
+    let rolled_back = guard(strand, &last_good, |_, _| good, index, report);
+    transmit_to_head(tally.head_force, rolled_back, report);
+}
+
+/// Steps one strand that a grab holds this step: two held ends (the root, the grabbed node),
+/// which follow-the-leader from the root alone cannot join. The pass runs without
+/// follow-the-leader and without eq. 14's feedback of its corrections (prediction, shape,
+/// collisions, frames; velocities `(x* − x)/Δt`), then the fast manifold projection (Kmoch
+/// Sec. 8.2, the rod's) makes every segment inextensible with the root and the grabbed nodes
+/// held — prescribed, or pulled by their couplings — updates the velocities by its moves, and
+/// gives the grabs' forces as the rod defines them. It always runs `rod.projection_iterations`
+/// (fixed cost, in either mode): a DFTL step's cost does not depend on the state, and a
+/// projection stopped at its tolerance kept a held, shaped strand trembling by 0.1 mm
+/// (`docs/design-departures.md`, "Grabs in DFTL").
+fn step_held_strand<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    setup: &Setup,
+    ctx: &StepContext,
+    (grabs, index): (&[Grab], u32),
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    let last_good: Positions<N> = snapshot(strand, report);
+    count_prediction(ctx, accelerations.is_some(), 1, report);
+    let roots = root_coupling(strand, ctx, report);
+    // Lines 16–27 but line 19, which the projection takes, eq. 14's feedback of its
+    // corrections, which the projection's own velocity update replaces, and the global shape
+    // constraint: the hand holds the strand out of its style, and pulled back toward a style
+    // it cannot reach the strand is drawn taut between the two (at 1 kHz, 0.7 mm a node a
+    // step on a strand held 14 cm short of its rest: the projection then trembles).
+    let unprojected = Setup {
+        inextensibility: false,
+        damping_over_dt: 0.0,
+        coefficients: DftlCoefficients {
+            global_shape: 0.0,
+            ..setup.coefficients
+        },
+        ..*setup
+    };
+    if unprojected.shape {
+        report.ran(Stage::Shape);
+    }
+    let (pass, tally) = strand_pass::<M, N>(&unprojected, ctx, strand, accelerations);
+    // The pass's push-outs act on the hair; its strain is the unprojected one: the
+    // projection measures the segments and the contacts after it.
+    let pushed = Tally {
+        collider_push: tally.collider_push,
+        ..Tally::default()
+    };
+    pushed.report(report, ctx.colliders().len(), setup.inv_dt);
+    // Lines 5–8 of Kmoch's Algorithm 1: inextensibility, collisions and the grabs.
+    let outcome = project_in_mode::<M, N>(strand, ctx, (grabs, index), Mode::FixedCost, report);
+    let good = not_finite_sum(roots + pass) == 0.0 && strand.is_finite();
+    let rolled_back = guard(strand, &last_good, |_, _| good, index, report);
+    if rolled_back {
+        forces_after_roll_back(ctx, grabs, (strand, index), report);
+    }
+    // What the head feels: the momentum the step gave besides the external forces, the
+    // colliders' and the grabs' (the projection reports what those feel, so less that).
+    let momentum = strand_momentum(strand);
+    let head = Tally::head_force(tally.external, momentum, &tally.collider_push, setup.inv_dt)
+        - outcome.collider_felt
+        - outcome.grab_felt;
+    transmit_to_head(head, rolled_back, report);
+}
+
+/// What one strand transmits to the head this step, `force`, into the report's `head_force`:
+/// nothing from a strand rolled back (its step did not happen) or a force that is not finite.
+#[inline(always)]
+fn transmit_to_head(force: Vec3, rolled_back: bool, report: &mut StepReport) {
+    if !rolled_back && crate::math::is_finite(force) {
+        report.head_force += force;
+    }
+}
+
+/// `Σ m_i v_i` over the free nodes (2 on) of `strand`, in node order.
+fn strand_momentum<const N: usize>(strand: &Strand<N>) -> Vec3 {
+    let n = strand.rest.nodes.min(N);
+    let (velocity, mass) = (&strand.state.velocity, &strand.rest.mass);
+    let mut momentum = V3::<Real>::zero();
+    for (v, &m) in velocity.iter().zip(mass).take(n).skip(2) {
+        momentum += V3::from(*v).scale(m);
+    }
+    momentum.into()
 }
 
 /// Counts lines 12–15, fused into the pass: the external forces where any act, and the
@@ -107,35 +198,30 @@ fn count_constraints(setup: &Setup, strands: u32, report: &mut StepReport) {
     report.ran_on(Stage::Velocity, strands);
 }
 
-/// The pass over one strand's free nodes with the effect switches fixed, and its tally into
-/// the report. Returns the [`component_sum`]s of the velocities it wrote, added.
+/// The pass over one strand's free nodes with the effect switches fixed. Returns the
+/// [`component_sum`]s of the velocities it wrote, added, and its tally for the report.
 fn strand_pass<M: Math, const N: usize>(
     setup: &Setup,
     ctx: &StepContext,
     strand: &mut Strand<N>,
     accelerations: Option<&[Vec3]>,
-    report: &mut StepReport,
-) -> Real {
+) -> (Real, Tally) {
     if strand.rest.nodes.min(N) < 3 {
-        return 0.0;
+        return (0.0, Tally::default());
     }
     let colliders = ctx.colliders();
     let mut collider_push = [V3::zero(); MAX_COLLIDERS];
-    let (measures, velocity_total) = with_effect_switches!(
+    let (measures, velocity_total, momenta) = with_effect_switches!(
         setup,
         nodes_of_strand::<M, N>(setup, strand, colliders, accelerations, &mut collider_push)
     );
-    Tally::from_measures::<M>(&measures, &collider_push).report(
-        report,
-        colliders.len(),
-        setup.inv_dt,
-    );
-    velocity_total
+    let tally = Tally::from_measures::<M>(&measures, &collider_push, momenta, setup.inv_dt);
+    (velocity_total, tally)
 }
 
 /// Nodes `2 …` of one strand with the effect switches fixed: lines 13–21 for node `i`, then
-/// lines 24–26 for node `i − 1`. Returns what it measured and the [`component_sum`]s of the
-/// velocities it wrote, added.
+/// lines 24–26 for node `i − 1`. Returns what it measured, the [`component_sum`]s of the
+/// velocities it wrote, added, and the free nodes' momenta.
 #[inline(never)]
 fn nodes_of_strand<
     M: Math,
@@ -149,7 +235,7 @@ fn nodes_of_strand<
     colliders: &[Shape],
     accelerations: Option<&[Vec3]>,
     collider_push: &mut ColliderPush<Real>,
-) -> (Measures<Real>, Real) {
+) -> (Measures<Real>, Real, Momenta<Real>) {
     // Two copies of the node loop, without the caller's accelerations (the firmware's case)
     // and with them: in one loop for both, the compiler kept the test and a select in it, 28
     // more instructions a node on x86-64 (a fifth of a node's cost without shape).
@@ -175,7 +261,7 @@ fn node_loop<M: Math, const N: usize>(
     colliders: &[Shape],
     extra: impl Fn(usize) -> Option<Vec3>,
     collider_push: &mut ColliderPush<Real>,
-) -> (Measures<Real>, Real) {
+) -> (Measures<Real>, Real, Momenta<Real>) {
     let n = strand.rest.nodes.min(N);
     let rest = &strand.rest;
     let state = &mut strand.state;
@@ -186,11 +272,13 @@ fn node_loop<M: Math, const N: usize>(
     let mut velocity_total: Real = 0.0;
     let mut previous_contact = false;
     let mut pending = Pending::start();
+    let mut momenta = Momenta::zero();
     for i in 2..n {
         let node = NodeInput::of_strand(rest, state, i, extra(i));
         // Lines 13–21: predict, shape, follow the leader, collisions, frame.
         let (m, c) = (&mut measures, &mut *collider_push);
         let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
+        momenta.external += next.kicked;
         // Lines 24–26: node i − 1 is final, node i − 2 has its whole reaction.
         if i >= 3 {
             let x = state.position[i - 1].into();
@@ -200,6 +288,7 @@ fn node_loop<M: Math, const N: usize>(
             if i >= 4 {
                 state.velocity[i - 2] = finished.into();
                 velocity_total += component_sum(finished);
+                momenta.after += finished.scale(rest.mass[i - 2]);
             }
             pending = rest_pending;
         }
@@ -208,21 +297,23 @@ fn node_loop<M: Math, const N: usize>(
     }
     // The last two nodes: no node after them (eq. 14 has no node n).
     let zero = V3::zero();
-    velocity_total += hand_on(&setup, state, (n, n), &mut pending, chain.position);
-    velocity_total += hand_on(&setup, state, (n + 1, n), &mut pending, zero);
-    (measures, velocity_total)
+    let at = (&mut pending, &mut momenta);
+    velocity_total += hand_on(&setup, (state, rest), (n, n), at, chain.position);
+    let at = (&mut pending, &mut momenta);
+    velocity_total += hand_on(&setup, (state, rest), (n + 1, n), at, zero);
+    (measures, velocity_total, momenta)
 }
 
 /// Lines 24–26 past the strand's end (`i ≥ n`, zero corrections), as the node loop does
 /// once node `i` is advanced: node `i − 1`'s final position `x_star` is stored (if it exists)
-/// and its velocity pends; node `i − 2`'s velocity, now whole, is stored. Returns the
-/// [`component_sum`] of the velocity stored.
+/// and its velocity pends; node `i − 2`'s velocity, now whole, is stored and its momentum
+/// counted. Returns the [`component_sum`] of the velocity stored.
 #[inline(always)]
 fn hand_on<const N: usize>(
     setup: &Setup,
-    state: &mut StrandState<N>,
+    (state, rest): (&mut StrandState<N>, &RestStrand<N>),
     (i, n): (usize, usize),
-    pending: &mut Pending<Real>,
+    (pending, momenta): (&mut Pending<Real>, &mut Momenta<Real>),
     x_star: V3<Real>,
 ) -> Real {
     let (local, inextensible) = (V3::zero(), V3::zero());
@@ -233,12 +324,13 @@ fn hand_on<const N: usize>(
         *position = x_star.into();
     }
     *pending = next;
-    match state.velocity.get_mut(i - 2).filter(|_| i >= 4) {
-        Some(velocity) => {
+    match (state.velocity.get_mut(i - 2), rest.mass.get(i - 2)) {
+        (Some(velocity), Some(&mass)) if i >= 4 => {
             *velocity = finished.into();
+            momenta.after += finished.scale(mass);
             component_sum(finished)
         }
-        None => 0.0,
+        _ => 0.0,
     }
 }
 
@@ -265,6 +357,9 @@ pub fn advance<M: Math, T: Lane>(
     };
     // Lines 13–14: external accelerations, prediction (eq. 1).
     let a = predict::acceleration(setup, velocity, node.mass, node.extra, node.has_extra);
+    // The momentum the node would end the step with under the external forces alone (its
+    // velocity as the step found it: the shape damping is the head's doing too).
+    let kicked = (node.velocity + a.scale(T::splat(setup.dt))).scale(node.mass);
     let mut x = predict::predicted_position(setup, node.position, velocity, a);
     // Line 18: shape, eqs. (8), (9) — the local target uses x* after the global step. Eq.
     // (14) feeds back the local and the follow-the-leader corrections, not the global one
@@ -318,6 +413,7 @@ pub fn advance<M: Math, T: Lane>(
         local,
         inextensible,
         contact,
+        kicked: V3::select(node.active, kicked, V3::zero()),
     }
 }
 
@@ -336,6 +432,42 @@ pub fn step_blocks<M: Math, const W: usize, const N: usize>(
         let block_accelerations = accelerations.and_then(|a| a.get(b * W * N..));
         let first = first_strand.wrapping_add((b * W) as u32);
         step_block::<M, W, N>(ctx, block, first, block_accelerations, report);
+    }
+}
+
+/// Steps DFTL strands kept in structure-of-arrays blocks as well (`blocks[b]` built from
+/// `strands[b·W ..]`, [`DftlBlock::from_strands`]): each block's state loaded from its strands,
+/// stepped in lanes ([`step_block`]) and stored back; a block holding a strand that a grab
+/// holds this step steps its strands one by one instead ([`step_strand`]: the held strand's
+/// projection works on a strand). The same bits either way. `first_strand` is the index of
+/// `strands[0]` in the scene; `accelerations`, if any, holds `N` per strand from it.
+pub fn step_strands_in_blocks<M: Math, const W: usize, const N: usize>(
+    ctx: &StepContext,
+    blocks: &mut [DftlBlock<W, N>],
+    strands: &mut [Strand<N>],
+    (first_strand, grabs): (u32, &[Grab]),
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    let setup = Setup::new(ctx);
+    for (b, (block, chunk)) in blocks.iter_mut().zip(strands.chunks_mut(W)).enumerate() {
+        let first = first_strand.wrapping_add((b * W) as u32);
+        let of_block = accelerations.and_then(|a| a.get(b * W * N..));
+        let held = chunk.iter().enumerate().any(|(l, strand)| {
+            let index = first.wrapping_add(l as u32);
+            !grabbed_nodes(ctx, grabs, index, strand.rest.nodes.min(N)).is_empty()
+        });
+        if held {
+            for (l, strand) in chunk.iter_mut().enumerate() {
+                let at = (grabs, first.wrapping_add(l as u32));
+                let of_strand = of_block.and_then(|a| a.get(l * N..(l + 1) * N));
+                step_strand::<M, N>(strand, &setup, ctx, at, of_strand, report);
+            }
+        } else {
+            block.load_state(chunk);
+            step_block::<M, W, N>(ctx, block, first, of_block, report);
+            block.store(chunk);
+        }
     }
 }
 
@@ -363,6 +495,7 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
         block_pass::<M, W, N>(ctx, &setup, block, accelerations, report)
     );
     // Quarantine: a lane that wrote a non-finite value gets its last good positions back.
+    let (pass, head_forces) = pass;
     let verdict = not_finite_sum(roots + pass);
     guard(
         block,
@@ -371,6 +504,9 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
         first_strand,
         report,
     );
+    for (l, &force) in head_forces.iter().enumerate().take(lanes as usize) {
+        transmit_to_head(force, verdict.0[l] != 0.0, report);
+    }
 }
 
 /// What the node loop of a block carries from node to node.
@@ -381,11 +517,12 @@ struct Carried<'a, const W: usize> {
     measures: &'a mut Measures<Wide<W>>,
     collider_push: &'a mut ColliderPush<Wide<W>>,
     velocity_total: &'a mut Wide<W>,
+    momenta: &'a mut Momenta<Wide<W>>,
 }
 
 /// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
 /// tally into the report. Returns, per lane, the [`component_sum`]s of the velocities it
-/// wrote, added.
+/// wrote, added, and the force the head feels from it (reported after the guard).
 #[inline(never)]
 fn block_pass<
     M: Math,
@@ -400,12 +537,12 @@ fn block_pass<
     block: &mut DftlBlock<W, N>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) -> Wide<W> {
+) -> (Wide<W>, [Vec3; W]) {
     let setup = setup.with_switches(SHAPE, INEXTENSIBLE, DRAG);
     let max_nodes = block.max_nodes.min(N);
     let mut velocity_total = Wide::splat(0.0);
     if max_nodes < 3 {
-        return velocity_total;
+        return (velocity_total, [Vec3::ZERO; W]);
     }
     let nodes = block.nodes;
     let nodes_real = Wide::new(core::array::from_fn(|l| nodes[l] as Real));
@@ -424,6 +561,7 @@ fn block_pass<
     let mut collider_push: ColliderPush<Wide<W>> = [V3::zero(); MAX_COLLIDERS];
     let mut previous_contact = Wide::<W>::mask(false);
     let mut pending = Pending::start();
+    let mut momenta = Momenta::zero();
     // Nodes every lane has: there every lane is active and every selection below is a
     // constant (the same bits as the masked form, without its blends).
     let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
@@ -435,6 +573,7 @@ fn block_pass<
             measures: &mut measures,
             collider_push: &mut collider_push,
             velocity_total: &mut velocity_total,
+            momenta: &mut momenta,
         };
         // Nodes 2 and 3 finish nothing (node 1 is held) and past the shortest lane the masks
         // select: both take the masked copy, so the pass holds two copies of a node, not four.
@@ -449,12 +588,13 @@ fn block_pass<
     for k in max_nodes..max_nodes + 2 {
         let zero = V3::zero();
         let (x_star, b) = (chain.position, &mut *block);
-        let (p, at) = (&mut pending, handing_lanes(k, nodes_real));
+        let (p, at) = ((&mut pending, &mut momenta), handing_lanes(k, nodes_real));
         let written = hand_on_lanes(&setup, b, at, p, x_star, (zero, zero));
         velocity_total += written;
     }
-    tally_lanes::<M, W, N>(ctx, &setup, block, &measures, &collider_push, report);
-    velocity_total
+    let measured = (&measures, &collider_push, momenta);
+    let head_forces = tally_lanes::<M, W, N>(ctx, &setup, block, measured, report);
+    (velocity_total, head_forces)
 }
 
 /// The lanes where node `k` is free (node 1 is held) and exists.
@@ -493,6 +633,7 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
         carried.measures,
         carried.collider_push,
     );
+    carried.momenta.external += next.kicked;
     // Lines 24–26 for nodes k − 1 and k − 2; a lane past its last node hands on zeros, as
     // the per-strand path does after a strand's last node.
     let local = V3::select(active, next.local, V3::zero());
@@ -503,7 +644,7 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     } else {
         handing_lanes(k, nodes_real)
     };
-    let pending = &mut *carried.pending;
+    let pending = (&mut *carried.pending, &mut *carried.momenta);
     let written = hand_on_lanes(setup, block, at, pending, x_star, (local, inextensible));
     *carried.velocity_total += written;
     *carried.chain = Chain::select(active, &next.chain, carried.chain);
@@ -512,8 +653,9 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
 
 /// Lines 24–26 once node `k` of every lane is advanced (or, past a lane's end, with zero
 /// corrections), as the per-strand path's `hand_on`: node `k − 1`'s final position `x_star`
-/// is stored where `moving` (it is free), and node `k − 2`'s velocity where `finishing`.
-/// Returns the [`component_sum`] of the velocities stored, 0 in the other lanes (whose
+/// is stored where `moving` (it is free), and node `k − 2`'s velocity where `finishing`, and
+/// its momentum counted. Returns the [`component_sum`] of the velocities stored, 0 in the
+/// other lanes (whose
 /// velocities the last guard saw finite): each lane's total adds its strand's per-strand terms
 /// in the same order, and zeros, which change no verdict. Constant masks fold away.
 #[inline(always)]
@@ -521,7 +663,7 @@ fn hand_on_lanes<const W: usize, const N: usize>(
     setup: &Setup,
     block: &mut DftlBlock<W, N>,
     (k, moving, finishing): (usize, WideMask<W>, WideMask<W>),
-    pending: &mut Pending<Wide<W>>,
+    (pending, momenta): (&mut Pending<Wide<W>>, &mut Momenta<Wide<W>>),
     x_star: V3<Wide<W>>,
     (local, inextensible): (V3<Wide<W>>, V3<Wide<W>>),
 ) -> Wide<W> {
@@ -534,6 +676,12 @@ fn hand_on_lanes<const W: usize, const N: usize>(
     block.store_position_where(k - 1, moving, x_star);
     *pending = next;
     let stored = block.store_velocity_where(k - 2, finishing, finished);
+    let mass = block
+        .mass
+        .get(k - 2)
+        .map_or(Wide::splat(0.0), |m| Wide::new(*m));
+    let after = momenta.after + stored.scale(mass);
+    momenta.after = V3::select(finishing, after, momenta.after);
     Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
 }
 
@@ -551,32 +699,46 @@ fn handing_lanes<const W: usize>(
     )
 }
 
-/// Each lane's tally into the report, in lane order.
+/// Each lane's tally into the report, in lane order. Returns each lane's force on the head
+/// (`Tally::head_force`).
 fn tally_lanes<M: Math, const W: usize, const N: usize>(
     ctx: &StepContext,
     setup: &Setup,
     block: &DftlBlock<W, N>,
-    measures: &Measures<Wide<W>>,
-    collider_push: &ColliderPush<Wide<W>>,
+    (measures, collider_push, momenta): (
+        &Measures<Wide<W>>,
+        &ColliderPush<Wide<W>>,
+        Momenta<Wide<W>>,
+    ),
     report: &mut StepReport,
-) {
+) -> [Vec3; W] {
     let (stretch, contact_stretch) = measures.stretches::<M>();
-    for l in 0..block.strands.min(W) {
+    let mut head_forces = [Vec3::ZERO; W];
+    for (l, head_force) in head_forces
+        .iter_mut()
+        .enumerate()
+        .take(block.strands.min(W))
+    {
         // The pushes are only read with colliders in the scene: no lane gathering without.
         let collider_push = if setup.collisions {
-            collider_push.map(|v| Vec3::new(v.x.0[l], v.y.0[l], v.z.0[l]))
+            collider_push.map(|v| v.lane(l))
         } else {
             [Vec3::ZERO; MAX_COLLIDERS]
         };
+        let (external, momentum) = (momenta.external.lane(l), momenta.after.lane(l));
         let tally = Tally {
             stretch: stretch.0[l],
             contact_stretch: contact_stretch.0[l],
             penetration: measures.penetration.0[l],
             contacts: measures.contacts.0[l] as u32,
             collider_push,
+            external,
+            head_force: Tally::head_force(external, momentum, &collider_push, setup.inv_dt),
         };
         tally.report(report, ctx.colliders().len(), setup.inv_dt);
+        *head_force = tally.head_force;
     }
+    head_forces
 }
 
 #[cfg(test)]

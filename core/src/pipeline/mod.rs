@@ -77,7 +77,8 @@ pub fn step_strands_with<M: Math, const N: usize>(
             let setup = Setup::new(ctx);
             for (k, strand) in strands.iter_mut().enumerate() {
                 let index = first_strand + k as u32;
-                dftl::step_strand::<M, N>(strand, &setup, ctx, index, of_strand(k), report);
+                let at = (grabs, index);
+                dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand(k), report);
             }
         }
     }

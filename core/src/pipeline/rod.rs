@@ -19,7 +19,7 @@
 
 use crate::context::StepContext;
 use crate::forces::External;
-use crate::grab::Grab;
+use crate::grab::{forces_after_roll_back, grabbed_nodes, Grab};
 use crate::guard::{guard, sound};
 use crate::lane::Natural;
 use crate::math::{unit, Math, Real, Vec3};
@@ -34,7 +34,7 @@ use crate::rod::substeps::{
 };
 use crate::rod::twist::ClampedFrames;
 use crate::rod::{implicit, twist, ClampedSegments, ElasticTerms};
-use crate::root_coupling::{carry_root_frame, held_velocity, root_coupling};
+use crate::root_coupling::{carry_root_frame, elastic_on_root, held_velocity, root_coupling};
 use crate::snapshot::snapshot;
 use crate::strand::{Strand, StrandState};
 
@@ -69,7 +69,7 @@ pub fn step_strand<M: Math, const N: usize>(
         report,
     );
     // Lines 3–4: forces and integration, in substeps or one linearly implicit step.
-    let angles = integrate(
+    let (angles, on_root) = integrate(
         strand,
         ctx,
         &begun,
@@ -79,7 +79,7 @@ pub fn step_strand<M: Math, const N: usize>(
     );
     // Lines 5–11.
     let at = (grabs, index, &mut scratch.projection);
-    finish(strand, ctx, at, &begun, frames, &angles, report);
+    finish(strand, ctx, at, (&begun, on_root), frames, &angles, report);
 }
 
 /// Scratch space for [`step_strand`]: the frames' buffer and the projection's lanes at one
@@ -194,7 +194,8 @@ where
     };
     let mut schedule = strand.schedule;
     let smallest = || (starting.smallest_denominator)(strand);
-    let integration = plan(ctx, &strand.rest.rod, &mut schedule, smallest);
+    let held = ctx.gates.grabs && !grabbed_nodes(ctx, grabs, index, strand.rest.nodes).is_empty();
+    let integration = plan(ctx, &strand.rest.rod, (&mut schedule, held), smallest);
     strand.schedule = schedule;
     Begun {
         last_good,
@@ -205,7 +206,8 @@ where
 }
 
 /// Lines 3–4 on one strand: its explicit substeps or its implicit step. `frames` are those of
-/// the centreline the step starts from.
+/// the centreline the step starts from. Returns the angles the forces used and the mean
+/// elastic force on the held nodes 0 and 1 over the step ([`Integrated`]).
 pub(super) fn integrate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -213,7 +215,7 @@ pub(super) fn integrate<M: Math, const N: usize>(
     frames: Option<&mut RodFrames<M, N>>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) -> [[Real; 2]; N] {
+) -> Integrated<N> {
     let clamped = &begun.clamped;
     match (begun.integration, frames) {
         (Integration::Implicit, Some(frames)) => {
@@ -226,25 +228,56 @@ pub(super) fn integrate<M: Math, const N: usize>(
     }
 }
 
+/// What lines 3–4 hand on: the `(cos θ^j, sin θ^j)` the forces used, and the mean elastic
+/// force on the held nodes 0 and 1 over the step (`root_coupling::elastic_on_root`).
+pub(super) type Integrated<const N: usize> = ([[Real; 2]; N], Vec3);
+
 /// Lines 5–11 of a strand's step, after its forces and integration: [`constrain`], the twist
-/// ([`twist_alone`]) and [`judge`]. `angles` are the `(cos θ^j, sin θ^j)` the forces used;
+/// ([`twist_alone`]) and [`judge`], then what the strand transmits to the head into the
+/// report ([`transmit_to_head`]: `on_root`, the elastic forces on nodes 0 and 1, and the
+/// projection's pull on node 1). `angles` are the `(cos θ^j, sin θ^j)` the forces used;
 /// `frames` a buffer for the frames, `projection` the projection's scratch space.
 pub(super) fn finish<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1, Natural>),
-    begun: &Begun<M, N>,
+    (begun, on_root): (&Begun<M, N>, Vec3),
     frames: Option<&mut RodFrames<M, N>>,
     angles: &[[Real; 2]; N],
     report: &mut StepReport,
 ) {
-    constrain(strand, ctx, (grabs, index, projection), begun, report);
+    let pull = constrain(strand, ctx, (grabs, index, projection), begun, report);
     twist_alone(strand, ctx, begun, frames, angles, report);
-    judge(strand, ctx, index, begun, report);
+    let rolled_back = judge(strand, ctx, index, begun, report);
+    transmit(
+        strand,
+        ctx,
+        (grabs, index),
+        (on_root + pull, rolled_back),
+        report,
+    );
+}
+
+/// What one rod strand transmits this step into the report: `force` to the head
+/// ([`transmit_to_head`]); from a strand rolled back, nothing to the head, and to its grabs'
+/// devices the forces of the state it went back to (`grab::forces_after_roll_back`).
+#[inline(always)]
+pub(super) fn transmit<const N: usize>(
+    strand: &Strand<N>,
+    ctx: &StepContext,
+    (grabs, index): (&[Grab], u32),
+    (force, rolled_back): (Vec3, bool),
+    report: &mut StepReport,
+) {
+    transmit_to_head(force, rolled_back, report);
+    if rolled_back && ctx.gates.grabs {
+        forces_after_roll_back(ctx, grabs, (strand, index), report);
+    }
 }
 
 /// Lines 5–9 (time): root coupling (Sec. 8.1), the root frame carried in time, then the fast
-/// manifold projection (inextensibility, collisions, grabs) and the velocities.
+/// manifold projection (inextensibility, collisions, grabs) and the velocities. Returns the
+/// projection's pull on the held node 1 (`projection::Outcome::root_pull`).
 #[inline(always)]
 pub(super) fn constrain<M: Math, const N: usize>(
     strand: &mut Strand<N>,
@@ -252,10 +285,22 @@ pub(super) fn constrain<M: Math, const N: usize>(
     (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1, Natural>),
     begun: &Begun<M, N>,
     report: &mut StepReport,
-) {
+) -> Vec3 {
     couple_root(strand, ctx, begun, report);
     if ctx.gates.projection {
-        project_strand::<M, N>(strand, ctx, (grabs, index), projection, report);
+        project_strand::<M, N>(strand, ctx, (grabs, index), projection, report).root_pull
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// What one rod strand transmits to the head this step, `force`, into the report's
+/// `head_force`: nothing from a strand rolled back (its step did not happen) or a force
+/// that is not finite (no NaN leaves a step).
+#[inline(always)]
+pub(super) fn transmit_to_head(force: Vec3, rolled_back: bool, report: &mut StepReport) {
+    if !rolled_back && crate::math::is_finite(force) {
+        report.head_force += force;
     }
 }
 
@@ -293,6 +338,7 @@ pub(super) fn twist_alone<M: Math, const N: usize>(
 }
 
 /// Line 11: the guard. A strand the explicit substeps lost takes the implicit step from now.
+/// Returns whether the strand was rolled back.
 #[inline(always)]
 pub(super) fn judge<M: Math, const N: usize>(
     strand: &mut Strand<N>,
@@ -300,11 +346,13 @@ pub(super) fn judge<M: Math, const N: usize>(
     index: u32,
     begun: &Begun<M, N>,
     report: &mut StepReport,
-) {
+) -> bool {
     let verdict = |s: &Strand<N>, _| sound(s, ctx.gates.inextensibility);
-    if guard(strand, &begun.last_good, verdict, index, report) {
+    let rolled_back = guard(strand, &begun.last_good, verdict, index, report);
+    if rolled_back {
         strand.schedule.implicit_bending = true;
     }
+    rolled_back
 }
 
 /// Lines 3–4 as `k` substeps of `h = dt/k` (`rod::substeps`): each the elastic forces of
@@ -313,7 +361,9 @@ pub(super) fn judge<M: Math, const N: usize>(
 /// between them (`rod::substeps::inextensibility_between_substeps`). `frames`, there when
 /// bending or twist is on, come in as those of the centreline the step starts from and are
 /// recomputed in place for each later substep. Returns `(cos θ^j, sin θ^j)` of the angles
-/// the forces used (the hair-optimised twist compares against them).
+/// the forces used (the hair-optimised twist compares against them) and the mean force on the
+/// held nodes 0 and 1 over the step: the elastic forces on them and, between substeps, the
+/// projections' pull on node 1.
 fn explicit_substeps<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -322,7 +372,7 @@ fn explicit_substeps<M: Math, const N: usize>(
     k: u32,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) -> [[Real; 2]; N] {
+) -> Integrated<N> {
     let h = ctx.dt / k as Real;
     let terms = ElasticTerms::of(&ctx.gates);
     let mut forces = [Vec3::ZERO; N];
@@ -339,6 +389,7 @@ fn explicit_substeps<M: Math, const N: usize>(
     let external = External::<M>::of(ctx);
     let mut motion = Motion::from(strand);
     let between = inextensibility_between_substeps(ctx, k, h);
+    let mut on_root = Vec3::ZERO;
     for substep in 0..k {
         if let Some(frames) = frames.as_deref_mut() {
             // The first substep starts where the frames were computed.
@@ -347,6 +398,7 @@ fn explicit_substeps<M: Math, const N: usize>(
             }
             let (theta, rest) = (&strand.state.theta, &strand.rest.rod);
             elastic_forces_with_angles(frames, theta, &cos_sin, rest, clamped, terms, &mut forces);
+            on_root += elastic_on_root::<M, N>(&forces);
         }
         let nodes = Nodes::<M, N> {
             count: strand.rest.nodes,
@@ -366,11 +418,12 @@ fn explicit_substeps<M: Math, const N: usize>(
         if let (Some(sub), true) = (&between, substep + 1 < k) {
             // Segment lengths between substeps; the step's own projection follows the last.
             let mut scratch = StepReport::default();
-            project_constraints::<M, N>(strand, sub, &[], 0, &mut scratch);
+            on_root += project_constraints::<M, N>(strand, sub, &[], 0, &mut scratch).root_pull;
             motion.restart(strand);
         }
     }
-    cos_sin
+    // Each substep's forces act for h = dt/k: their mean over the step.
+    (cos_sin, on_root * (1.0 / k as Real))
 }
 
 /// Lines 3–4 as one linearly implicit bending step of `dt` (`rod::implicit`): the elastic
@@ -388,7 +441,7 @@ fn implicit_bending<M: Math, const N: usize>(
     frames: &RodFrames<M, N>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) -> [[Real; 2]; N] {
+) -> Integrated<N> {
     report.ran(Stage::ElasticForces);
     report.ran(Stage::ExternalForces);
     report.ran(Stage::Integrate);
@@ -400,8 +453,8 @@ fn implicit_bending<M: Math, const N: usize>(
     elastic_forces_with_angles(frames, theta, &cos_sin, rest, clamped, terms, &mut forces);
     // The head's motion of nodes 0 and 1 this step: the solve's boundary condition.
     let held = [0, 1].map(|i| held_velocity(ctx, strand, i));
-    implicit::step(strand, ctx, frames, &forces, held, accelerations);
-    cos_sin
+    let on_root = implicit::step(strand, ctx, frames, &forces, held, accelerations);
+    (cos_sin, on_root)
 }
 
 /// What the step keeps of the configuration it starts from: the root tangent (for the

@@ -35,11 +35,12 @@ use crate::rod::twist::{
     TwistMethod,
 };
 use crate::rod::{ClampedSegments, ElasticTerms, RootOnly};
-use crate::root_coupling::held_velocity;
+use crate::root_coupling::{elastic_on_root, held_velocity};
 use crate::strand::Strand;
 
 use super::rod::{
-    begin, couple_root, integrate, judge, starting_from, twist_alone, Begun, RodScratch, Starting,
+    begin, couple_root, integrate, judge, starting_from, transmit, twist_alone, Begun, RodScratch,
+    Starting,
 };
 
 /// Scratch space for [`step_block`], kept by the caller from step to step: the lanes, their
@@ -126,6 +127,8 @@ struct BlockStep<'s, M: Math, const N: usize, const W: usize> {
     implicit: [bool; W],
     /// `(cos θ^j, sin θ^j)` each strand's forces used.
     angles: [[[Real; 2]; N]; W],
+    /// Each strand's mean elastic force on its held nodes 0 and 1 over the step.
+    on_root: [Vec3; W],
 }
 
 impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
@@ -155,6 +158,7 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
             substeps: [0; W],
             implicit: [false; W],
             angles: [[[1.0, 0.0]; N]; W],
+            on_root: [Vec3::ZERO; W],
         }
     }
 
@@ -246,7 +250,7 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
         } = &mut *self.scratch;
         if self.lanes && self.implicit.contains(&true) {
             let implicit = &self.implicit;
-            implicit_in_lanes(
+            let on_root = implicit_in_lanes(
                 block,
                 lane_frames,
                 (strands, implicit),
@@ -255,11 +259,15 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
                 report,
             );
             block.scatter(strands, implicit, &mut self.angles);
+            take_lanes(&mut self.on_root, implicit, on_root);
         }
         if self.lanes && self.substeps.iter().any(|&k| k > 0) {
             let substeps = &self.substeps;
-            explicit_substeps_in_lanes(block, lane_frames, ctx, &clamped, substeps, report);
-            block.scatter(strands, &substeps.map(|k| k > 0), &mut self.angles);
+            let on_root =
+                explicit_substeps_in_lanes(block, lane_frames, ctx, &clamped, substeps, report);
+            let in_lanes = substeps.map(|k| k > 0);
+            block.scatter(strands, &in_lanes, &mut self.angles);
+            take_lanes(&mut self.on_root, &in_lanes, on_root);
         }
         let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
         for (lane, strand) in strands.iter_mut().enumerate().take(W) {
@@ -272,7 +280,8 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
                 &mut alone.frames
             });
             let acc = of_strand(lane);
-            self.angles[lane] = integrate(strand, ctx, begun, frames, acc, report);
+            (self.angles[lane], self.on_root[lane]) =
+                integrate(strand, ctx, begun, frames, acc, report);
         }
     }
 
@@ -300,7 +309,7 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
         } = &mut *self.scratch;
         let projections = ((projection, ending), &mut alone.projection);
         let at = (grabs, first_strand);
-        project(strands, &self.begun, ctx, at, projections, report);
+        let pulls = project(strands, &self.begun, ctx, at, projections, report);
         // The twist in lanes for the strands in them that hold no segment but the root (a
         // grabbed segment's saved frame is transported strand by strand).
         let in_lanes: [bool; W] = core::array::from_fn(|lane| {
@@ -321,14 +330,27 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
                 let frames = ctx.gates.frames.then_some(&mut alone.frames);
                 twist_alone(strand, ctx, begun, frames, &self.angles[lane], report);
             }
-            judge(strand, ctx, first_strand + lane as u32, begun, report);
+            let index = first_strand + lane as u32;
+            let rolled_back = judge(strand, ctx, index, begun, report);
+            let force = self.on_root[lane] + pulls[lane];
+            transmit(strand, ctx, (grabs, index), (force, rolled_back), report);
+        }
+    }
+}
+
+/// Lane `l` of `lanes` into `each[l]` where `taken[l]`.
+fn take_lanes<const W: usize>(each: &mut [Vec3; W], taken: &[bool; W], lanes: V3<Wide<W>>) {
+    for (l, slot) in each.iter_mut().enumerate() {
+        if taken[l] {
+            *slot = lanes.lane(l);
         }
     }
 }
 
 /// Line 9 (time) of each strand with a start in `begun`: the fast manifold projection, in
 /// lanes for the strands laid out alike (`projection::lanes::fits_lanes`) when two or more
-/// are, alone for the others; each strand's result taken in scene order.
+/// are, alone for the others; each strand's result taken in scene order. Returns each
+/// strand's pull on its held node 1 (`projection::Outcome::root_pull`).
 fn project<M: Math, const N: usize, const W: usize>(
     strands: &mut [Strand<N>],
     begun: &[Option<Begun<M, N>>; W],
@@ -336,9 +358,10 @@ fn project<M: Math, const N: usize, const W: usize>(
     (grabs, first_strand): (&[Grab], u32),
     ((lanes, ending), alone): ProjectionScratch<'_, N, W>,
     report: &mut StepReport,
-) {
+) -> [Vec3; W] {
+    let mut pulls = [Vec3::ZERO; W];
     if !ctx.gates.projection {
-        return;
+        return pulls;
     }
     let nodes = strands.first().map_or(0, |s| s.rest.nodes.min(N));
     let taken: [bool; W] = core::array::from_fn(|lane| {
@@ -353,17 +376,17 @@ fn project<M: Math, const N: usize, const W: usize>(
             continue;
         }
         // A strand `taken` fits the lanes' kernel: no second `fits_lanes` for it.
-        if in_lanes && taken[lane] {
-            lanes.finish::<M>(lane, strand, ctx, report, Some(&*ending));
-            continue;
-        }
-        if taken[lane] {
-            project_alone::<M, N>(strand, ctx, alone, report);
+        let outcome = if in_lanes && taken[lane] {
+            lanes.finish::<M>(lane, strand, ctx, report, Some(&*ending))
+        } else if taken[lane] {
+            project_alone::<M, N>(strand, ctx, alone, report)
         } else {
             let at = (grabs, first_strand + lane as u32);
-            project_strand::<M, N>(strand, ctx, at, alone, report);
-        }
+            project_strand::<M, N>(strand, ctx, at, alone, report)
+        };
+        pulls[lane] = outcome.root_pull;
     }
+    pulls
 }
 
 /// The projections' scratch space of a block: its lanes with their ending, and one strand's.
@@ -426,7 +449,7 @@ fn implicit_in_lanes<M: Math, const N: usize, const W: usize>(
     ctx: &StepContext,
     clamped: &[ClampedSegments; W],
     report: &mut StepReport,
-) {
+) -> V3<Wide<W>> {
     let lanes = implicit.iter().filter(|&&i| i).count() as u32;
     report.ran_on(Stage::ElasticForces, lanes);
     report.ran_on(Stage::ExternalForces, lanes);
@@ -474,7 +497,7 @@ fn implicit_in_lanes<M: Math, const N: usize, const W: usize>(
         frames,
         (h, held),
         WideMask::from_bools(*implicit),
-    );
+    )
 }
 
 /// Whether `k` substeps run without a projection between them (what the lanes do).
@@ -486,7 +509,8 @@ fn plain(ctx: &StepContext, k: u32) -> bool {
 /// `dt / substeps[l]` (none for 0) and keeping still once it has taken them: the same kernels
 /// — frame pass, elastic forces, symplectic Euler — on each lane's values, so each strand gets
 /// the bits it gets alone. `frames` come in as those of the configuration the step starts
-/// from and are recomputed in place for each later substep.
+/// from and are recomputed in place for each later substep. Returns each lane's mean
+/// elastic force on its held nodes 0 and 1 over the step.
 fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
     block: &mut LaneBlock<N, W>,
     frames: &mut RodFrames<Lanes<M, W>, N>,
@@ -494,7 +518,7 @@ fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
     clamped: &[ClampedSegments; W],
     substeps: &[u32; W],
     report: &mut StepReport,
-) {
+) -> V3<Wide<W>> {
     let lanes = substeps.iter().filter(|&&k| k > 0).count() as u32;
     report.ran_on(Stage::ElasticForces, lanes);
     report.ran_on(Stage::ExternalForces, lanes);
@@ -509,6 +533,7 @@ fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
     let mut forces = [V3::<Wide<W>>::zero(); N];
     let mut motion = starting_at::<Lanes<M, W>, N>(block.position);
     let nodes = block.nodes;
+    let mut on_root = V3::<Wide<W>>::zero();
     for substep in 0..most {
         // The first substep starts where the frames were computed.
         if substep > 0 {
@@ -527,7 +552,11 @@ fn explicit_substeps_in_lanes<M: Math, const N: usize, const W: usize>(
             inverse_mass: &block.inverse_mass,
         };
         let active = WideMask::from_bools(substeps.map(|k| substep < k));
+        let share = elastic_on_root::<Lanes<M, W>, N>(&forces);
+        on_root = V3::select(active, on_root + share, on_root);
         let acc = block.accelerations.as_ref().map(|a| &a[..]);
         symplectic_euler(lane_nodes, &external, &forces, h, acc, &mut motion, active);
     }
+    // As `super::rod::explicit_substeps`: the mean over each lane's substeps.
+    on_root * Wide::new(substeps.map(|k| 1.0 / k.max(1) as Real))
 }

@@ -32,9 +32,9 @@ use super::constraints::{
     evaluate_contacts, measure_segments, resolution_floor, ContactMemory, Layout, Nodes, Rows,
 };
 use super::{
-    conclude, free_nodes, layout_of, project_constraints, prune_tentative, push_on_colliders,
-    record_outcome, segment_stretch, trust_radius, trust_scale, usable_colliders, Findings,
-    NearColliders, Outcome,
+    conclude, felt_by_colliders, free_nodes, layout_of, project_constraints, prune_tentative,
+    push_on_colliders, record_outcome, segment_stretch, trust_radius, trust_scale,
+    usable_colliders, Findings, NearColliders, Outcome,
 };
 
 /// Whether strand `strand` (index `index` in the scene) can be projected in lanes with
@@ -101,6 +101,8 @@ struct Lane<const N: usize> {
     rows: Rows<N>,
     contacts: ContactMemory<N>,
     collider_push: [Vec3; MAX_COLLIDERS],
+    /// Segment 1's pull on the held node 1, × h² (`super::pull_on_root`).
+    root_pull: Vec3,
     near: NearColliders,
     outcome: Outcome,
     truncated: bool,
@@ -153,6 +155,7 @@ impl<const N: usize> Lane<N> {
         rows: Rows::new(),
         contacts: ContactMemory::new(),
         collider_push: [Vec3::ZERO; MAX_COLLIDERS],
+        root_pull: Vec3::ZERO,
         near: NearColliders::none(),
         outcome: Outcome {
             iterations: 0,
@@ -160,6 +163,9 @@ impl<const N: usize> Lane<N> {
             converged: false,
             dropped_rows: 0,
             collision_rows: 0,
+            root_pull: Vec3::ZERO,
+            collider_felt: Vec3::ZERO,
+            grab_felt: Vec3::ZERO,
         },
         truncated: false,
         trust_radius: 0.0,
@@ -234,6 +240,7 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             book.near = NearColliders::new(strand, &book.nodes, shapes, layout.contact_slots > 0);
             book.contacts.forget();
             book.collider_push = [Vec3::ZERO; MAX_COLLIDERS];
+            book.root_pull = Vec3::ZERO;
             book.outcome = Outcome::default();
             book.truncated = false;
             book.trust_radius = trust_radius(strand, nodes);
@@ -283,6 +290,7 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             truncated: book.truncated,
             collider_push: &book.collider_push,
         };
+        let root_pull = book.root_pull * (ctx.inv_dt * ctx.inv_dt);
         let Some(concluded) = ending.map(|e| &e.concluded).filter(|c| c.finite[lane]) else {
             // Measured strand by strand (one strand alone), or an overflow on absurd input
             // (rare): the strand's own ending, which keeps the positions it came in with if
@@ -291,7 +299,11 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             for (x, lanes) in strand.state.position.iter_mut().zip(&self.position).take(n) {
                 *x = lanes.lane(lane);
             }
-            return conclude::<M, N>(strand, &predicted, ctx, book.outcome, findings, report);
+            let outcome = conclude::<M, N>(strand, &predicted, ctx, book.outcome, findings, report);
+            return Outcome {
+                root_pull,
+                ..outcome
+            };
         };
         // `conclude`, with what `LaneEnding::measure` measured in lanes: the same bits.
         let state = &mut strand.state;
@@ -306,7 +318,11 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
         report.max_stretch = report.max_stretch.max(concluded.free_stretch[lane]);
         let at_contacts = concluded.contact_stretch[lane];
         report.max_contact_stretch = report.max_contact_stretch.max(at_contacts);
-        book.outcome
+        Outcome {
+            root_pull,
+            collider_felt: felt_by_colliders(ctx, &book.collider_push),
+            ..book.outcome
+        }
     }
 
     /// `super::iterate` in lanes: evaluate, test, solve, move, each lane until it stops.
@@ -478,6 +494,10 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             if !moving.get(l) {
                 continue;
             }
+            // `super::pull_on_root`: row 0 is segment 1, whose gradient at node 1 is `−∇C`
+            // at node 2.
+            let at_root = -self.gradient[0].lane(l);
+            book.root_pull -= at_root * (self.multipliers[0].0[l] * scale.0[l]);
             if any_contact[l] {
                 let (gradient, multipliers) = (&self.gradient, &self.multipliers);
                 let pull = |_: &Rows<N>, i| segment_pull(gradient, multipliers, n, i, l);

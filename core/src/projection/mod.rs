@@ -38,7 +38,7 @@ pub mod lanes;
 use crate::collide::{Shape, MAX_COLLIDERS};
 use crate::context::StepContext;
 use crate::effects::Effect;
-use crate::grab::{grabbed_nodes, Grab, GrabbedNodes, MAX_GRABS};
+use crate::grab::{grabbed_nodes, Coupling, Grab, GrabbedNodes, MAX_GRABS};
 use crate::lane::{Lane, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::Mode;
@@ -50,7 +50,6 @@ use constraints::{magnitude, ContactMemory, Layout, Nodes, Rows, MAX_NODE_CONTAC
 
 /// What one projection did, besides what it adds to the report.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Outcome {
     /// Iterations run (solves), at most the cap.
     pub iterations: u32,
@@ -63,6 +62,32 @@ pub struct Outcome {
     /// Collision rows at the iterates a solve followed, summed over iterations
     /// ([`constraints::Rows::collision_rows`]).
     pub collision_rows: u32,
+    /// The force the held node 1 feels from segment 1's row, `−∇_{x_1}C_1ᵀ Λ_1 / h²`, N: the
+    /// projection's share of what the strand transmits to the head.
+    pub root_pull: Vec3,
+    /// The force the colliders feel from this strand's collision rows, summed, N.
+    pub collider_felt: Vec3,
+    /// The force the devices of this strand's grabs feel, summed, N.
+    pub grab_felt: Vec3,
+}
+
+#[cfg(feature = "defmt")]
+impl defmt::Format for Outcome {
+    fn format(&self, f: defmt::Formatter) {
+        use crate::math::DefmtVec3;
+        defmt::write!(
+            f,
+            "Outcome {{ iterations: {}, residual: {}, converged: {}, dropped_rows: {}, collision_rows: {}, root_pull: {}, collider_felt: {}, grab_felt: {} }}",
+            self.iterations,
+            self.residual,
+            self.converged,
+            self.dropped_rows,
+            self.collision_rows,
+            DefmtVec3(self.root_pull),
+            DefmtVec3(self.collider_felt),
+            DefmtVec3(self.grab_felt)
+        )
+    }
 }
 
 /// Scratch space of one projection: fixed arrays on the stack, nothing on the heap.
@@ -77,6 +102,8 @@ struct Workspace<const N: usize> {
     multipliers: [Real; N],
     /// `Σ_k −∇_{x_g}C_kᵀ δλ_k` per grab slot: the segments' pull on the grabbed node, × h².
     grab_pull: [Vec3; MAX_GRABS],
+    /// `Σ_k −∇_{x_1}C_1ᵀ δλ_1`: segment 1's pull on the held node 1, × h².
+    root_pull: Vec3,
     /// One iteration's `Δx` per node.
     step: [Vec3; N],
     /// Longest move of a node in one iteration: ten times the strand's rest length, m.
@@ -115,6 +142,19 @@ pub fn project_constraints<M: Math, const N: usize>(
     strand_index: u32,
     report: &mut StepReport,
 ) -> Outcome {
+    let at = (grabs, strand_index);
+    project_in_mode::<M, N>(strand, ctx, at, ctx.params.mode, report)
+}
+
+/// [`project_constraints`] in `mode` rather than the scene's: DFTL's held strands always
+/// take the fixed cost (`pipeline::dftl`).
+pub(crate) fn project_in_mode<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    (grabs, strand_index): (&[Grab], u32),
+    mode: Mode,
+    report: &mut StepReport,
+) -> Outcome {
     #[allow(clippy::let_unit_value)]
     let () = IndexFits::<N>::OK;
     let inextensibility = ctx.has(Effect::Inextensibility);
@@ -129,9 +169,9 @@ pub fn project_constraints<M: Math, const N: usize>(
     let n = strand.rest.nodes.min(N);
     let held = grabbed_nodes(ctx, grabs, strand_index, n);
     let mut work = Workspace::new(strand, n);
-    prescribe_grabs(strand, grabs, &held, &mut work.nodes);
+    prescribe_grabs::<M, N>(strand, ctx, grabs, &held, &mut work);
     let (shapes, shape_count) = usable_colliders(ctx);
-    let layout = layout_of(ctx, shape_count);
+    let layout = layout_in_mode(ctx, shape_count, mode);
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
     let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
     let findings = Findings {
@@ -140,8 +180,9 @@ pub fn project_constraints<M: Math, const N: usize>(
         truncated: work.truncated,
         collider_push: &work.collider_push,
     };
-    let outcome = conclude::<M, N>(strand, &work.predicted, ctx, outcome, findings, report);
-    record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
+    let mut outcome = conclude::<M, N>(strand, &work.predicted, ctx, outcome, findings, report);
+    outcome.root_pull = work.root_pull * (ctx.inv_dt * ctx.inv_dt);
+    outcome.grab_felt = record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
     outcome
 }
 
@@ -159,12 +200,25 @@ fn conclude<M: Math, const N: usize>(
     keep_finite(strand, predicted, n, ctx.inv_dt, &mut outcome);
     report.ran(Stage::Velocity);
     update_velocities(strand, predicted, ctx.inv_dt);
+    outcome.collider_felt = felt_by_colliders(ctx, findings.collider_push);
     record::<M, N>(strand, ctx, &outcome, findings, report);
     outcome
 }
 
+/// The force all colliders feel from one strand's collision rows, N: the sum of the
+/// collider pushes (× h²) the report adds collider by collider.
+pub(crate) fn felt_by_colliders(ctx: &StepContext, push: &[Vec3; MAX_COLLIDERS]) -> Vec3 {
+    let total = push.iter().fold(Vec3::ZERO, |sum, &p| sum + p);
+    total * (ctx.inv_dt * ctx.inv_dt)
+}
+
 /// The rows the step's effects ask for, with `shape_count` usable colliders.
 fn layout_of(ctx: &StepContext, shape_count: usize) -> Layout {
+    layout_in_mode(ctx, shape_count, ctx.params.mode)
+}
+
+/// [`layout_of`] in `mode` rather than the scene's.
+fn layout_in_mode(ctx: &StepContext, shape_count: usize, mode: Mode) -> Layout {
     let collisions = ctx.has(Effect::Collisions);
     Layout {
         inextensibility: ctx.has(Effect::Inextensibility),
@@ -173,10 +227,10 @@ fn layout_of(ctx: &StepContext, shape_count: usize) -> Layout {
         } else {
             0
         },
-        fixed_cost: ctx.params.mode == Mode::FixedCost,
+        fixed_cost: mode == Mode::FixedCost,
         // Tentative rows may cost a second solve: converge mode only, so that fixed cost
         // keeps one solve per iteration.
-        contact_margin: collisions && ctx.params.mode == Mode::Converge,
+        contact_margin: collisions && mode == Mode::Converge,
         residual_only: false,
     }
 }
@@ -268,6 +322,7 @@ impl<const N: usize> Workspace<N> {
             band: [[0.0; banded::MAX_HALF_BANDWIDTH + 1]; N],
             multipliers: [0.0; N],
             grab_pull: [Vec3::ZERO; MAX_GRABS],
+            root_pull: Vec3::ZERO,
             step: [Vec3::ZERO; N],
             trust_radius: trust_radius(strand, n),
             collider_push: [Vec3::ZERO; MAX_COLLIDERS],
@@ -295,23 +350,90 @@ pub(crate) fn usable_colliders(ctx: &StepContext) -> ([(u8, Shape); MAX_COLLIDER
     (shapes, count)
 }
 
-/// Grabbed nodes are prescribed: moved to their targets, infinite mass, no rows.
-fn prescribe_grabs<const N: usize>(
+/// Grabbed nodes: a prescribed one is moved to its target, with infinite mass and no rows
+/// (Kmoch Sec. 8.1); a coupled one is moved to where its implicit spring-damper alone would
+/// take it, with the coupling's stiffness in its mass ([`coupled_node`]), then within the
+/// strand's reach of node 1 ([`within_reach_of_root`]).
+fn prescribe_grabs<M: Math, const N: usize>(
     strand: &mut Strand<N>,
+    ctx: &StepContext,
     grabs: &[Grab],
     held: &GrabbedNodes,
-    nodes: &mut Nodes<N>,
+    work: &mut Workspace<N>,
 ) {
     for (g, node) in held.iter() {
-        if let (Some(grab), Some(x), Some(w)) = (
+        let state = &mut strand.state;
+        let root = state.position.get(1).copied().unwrap_or(Vec3::ZERO);
+        if let (Some(grab), Some(x), Some(&v), Some(w)) = (
             grabs.get(g),
-            strand.state.position.get_mut(node),
-            nodes.inverse_mass.get_mut(node),
+            state.position.get_mut(node),
+            state.velocity.get(node),
+            work.nodes.inverse_mass.get_mut(node),
         ) {
-            *x = grab.target;
-            *w = 0.0;
+            let Some(coupling) = grab.coupling else {
+                (*x, *w) = (grab.target, 0.0);
+                continue;
+            };
+            let (start, inverse_mass) = coupled_node(ctx, grab, &coupling, (*x, v), *w);
+            let reach = strand
+                .rest
+                .segment_length
+                .get(1..node)
+                .map_or(0.0, |lengths| lengths.iter().sum::<Real>());
+            let within = within_reach_of_root::<M>(start, root, reach);
+            // The strand's pull that brings the node within reach acts between it and node 1.
+            if inverse_mass > 0.0 {
+                work.root_pull -= (within - start) * (1.0 / inverse_mass);
+            }
+            (*x, *w) = (within, inverse_mass);
         }
     }
+}
+
+/// A coupled node's start `start` within `reach` of node 1 (at `root`): an inextensible strand
+/// holds it there, whatever its spring pulls. Projected onto the ball first (`REACH_SLACK`
+/// inside it, so that the strand is not exactly straight, where the projection's Newton
+/// steps stall), the projection then starts from a configuration it can reach: from 70 cm
+/// out (a target teleported 1 m from a 30-node strand's root, coupled at 1 N/m), 12
+/// iterations left the strand stretched 7–17-fold.
+fn within_reach_of_root<M: Math>(start: Vec3, root: Vec3, reach: Real) -> Vec3 {
+    let radius = reach * (1.0 - crate::grab::REACH_SLACK);
+    let out = start - root;
+    let distance2 = out.dot(out);
+    if distance2 <= radius * radius || !distance2.is_finite() {
+        return start;
+    }
+    root + out * (radius / M::sqrt(distance2))
+}
+
+/// A coupled node's start in the projection and its inverse mass there. The coupling's energy
+/// over the step, `½ K |x − T|² Δt² + ½ B Δt |Δt (v⁺ − v_T)|²` with `v⁺ = v + (x − x̃)/Δt` (the
+/// projection's velocity update), added to the projection's `½ m |x − x̃|²`, is one quadratic
+/// `½ M |x − x_c|²`:
+///
+/// `M = m + K Δt² + B Δt`, `x_c = x̃ + (K Δt² (T − x̃) − B Δt² (v − v_T)) / M`,
+///
+/// so projecting from `x_c` with mass `M` is the implicit (backward Euler) step of the spring
+/// and damper together with the constraints: stable for any `K, B ≥ 0`. `x̃`, `v` are the
+/// node's position and velocity after integration; `v_T = (T − T_prev)/Δt` the target's
+/// velocity; `w` the node's inverse mass (0 if it has none: then it stays prescribed).
+fn coupled_node(
+    ctx: &StepContext,
+    grab: &Grab,
+    coupling: &Coupling,
+    (x, v): (Vec3, Vec3),
+    w: Real,
+) -> (Vec3, Real) {
+    if w <= 0.0 {
+        return (grab.target, 0.0);
+    }
+    let dt = ctx.dt;
+    let spring = coupling.stiffness * dt * dt;
+    let damper = coupling.damping * dt;
+    let mass = 1.0 / w + spring + damper;
+    let target_velocity = (grab.target - grab.previous_target) * ctx.inv_dt;
+    let pull = (grab.target - x) * spring - (v - target_velocity) * (damper * dt);
+    (x + pull / mass, 1.0 / mass)
 }
 
 /// The projection's iterations: evaluate, test, solve, move — at most the cap, always the cap
@@ -615,6 +737,7 @@ fn solve_and_move<M: Math, const N: usize>(
         *x += *dx * scale;
     }
     pull_on_grabs(work, held, count, scale);
+    pull_on_root(work, scale);
     if any_contact {
         push_on_colliders_alone(work, count, n, scale);
     }
@@ -689,6 +812,22 @@ fn pull_on_grabs<const N: usize>(
             if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
                 *pull -= gradient * (lambda * scale);
             }
+        }
+    }
+}
+
+/// Segment 1's pull on the held node 1 from the multiplier actually applied (`scale · δλ`),
+/// into `work.root_pull`: node 1 is prescribed, so segment 1 is the only row through it.
+#[inline(always)]
+fn pull_on_root<const N: usize>(work: &mut Workspace<N>, scale: Real) {
+    let r = work
+        .rows
+        .segment_row
+        .get(1)
+        .map_or(usize::MAX, |&r| usize::from(r));
+    if let (Some(row), Some(&lambda)) = (work.rows.rows().get(r), work.multipliers.get(r)) {
+        if let Some(k) = row.nodes.iter().position(|&node| node == 1) {
+            work.root_pull -= row.gradients()[k] * (lambda * scale);
         }
     }
 }
@@ -901,7 +1040,7 @@ fn record_outcome<const N: usize>(
     }
 }
 
-/// Each held grab's force on its device, and whether it slipped.
+/// Each held grab's force on its device, and whether it slipped. Returns their sum.
 fn record_grabs<M: Math, const N: usize>(
     strand: &Strand<N>,
     ctx: &StepContext,
@@ -909,26 +1048,34 @@ fn record_grabs<M: Math, const N: usize>(
     held: &GrabbedNodes,
     work: &Workspace<N>,
     report: &mut StepReport,
-) {
+) -> Vec3 {
     let inv_h2 = ctx.inv_dt * ctx.inv_dt;
+    let mut total = Vec3::ZERO;
     for (g, node) in held.iter() {
-        let (Some(grab), Some(&pull), Some(&mass), Some(&x), Some(&x_pred)) = (
+        let state = &strand.state;
+        let (Some(grab), Some(&pull), Some(&mass), Some(&x), Some(&v), Some(&x_pred)) = (
             grabs.get(g),
             work.grab_pull.get(g),
             strand.rest.mass.get(node),
-            strand.state.position.get(node),
+            state.position.get(node),
+            state.velocity.get(node),
             work.predicted.get(node),
         ) else {
             continue;
         };
-        // −Σ ∇_{x_g}C_jᵀΛ_j/h² − m_g(a_g − g), with m_g(a_g − g) = m_g Δx_g/h².
-        let delta_x = x - x_pred;
-        let felt = (pull - delta_x * mass) * inv_h2;
+        let felt = match grab.coupling {
+            // −Σ ∇_{x_g}C_jᵀΛ_j/h² − m_g(a_g − g), with m_g(a_g − g) = m_g Δx_g/h².
+            None => (pull - (x - x_pred) * mass) * inv_h2,
+            // The coupling's spring and damper at the step's end, as the projection applied
+            // them (`coupled_node`).
+            Some(c) => crate::grab::coupling_force(&c, x, v, grab, ctx.inv_dt),
+        };
         // A strand that blew up before or in its projection (the guard rolls it back) has no
         // force to report: no NaN leaves the step through the grab's force.
         if !crate::math::is_finite(felt) {
             continue;
         }
+        total += felt;
         if let Some(force) = report.grab_forces.get_mut(g) {
             *force += felt;
         }
@@ -937,6 +1084,7 @@ fn record_grabs<M: Math, const N: usize>(
             report.flags.insert(Flags::GRAB_SLIPPED);
         }
     }
+    total
 }
 
 #[cfg(test)]

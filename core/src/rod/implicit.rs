@@ -599,7 +599,7 @@ pub fn step<M: Math, const N: usize>(
     forces: &[Vec3; N],
     held_velocity: [Vec3; 2],
     accelerations: Option<&[Vec3]>,
-) {
+) -> Vec3 {
     let state = &mut strand.state;
     let rest = &strand.rest;
     let nodes = Nodes::<M, N> {
@@ -616,7 +616,7 @@ pub fn step<M: Math, const N: usize>(
         external: &external,
         accelerations,
     };
-    step_nodes(nodes, &loads, frames, (ctx.dt, held_velocity), true);
+    step_nodes(nodes, &loads, frames, (ctx.dt, held_velocity), true)
 }
 
 /// [`step`] of one strand's nodes or of `W` strands' in lanes (`lane::Lanes`): the same
@@ -628,26 +628,45 @@ pub fn step_nodes<P: Kernel, const N: usize>(
     frames: &RodFrames<P, N>,
     (h, held_velocity): (P::R, [P::V; 2]),
     active: <P::R as Arithmetic>::Mask,
-) {
+) -> P::V {
     let n = nodes.count.min(N);
     let mut system = BendingSystem::<P, N>::default();
     system.assemble(frames, loads.mass, loads.rest, h);
     system.factor();
     // Right-hand side M (v + h a), with a as in the explicit step.
     let mut rhs = [[P::R::ZERO; 3]; N];
+    let mut explicit_momentum = P::V::ZERO;
     for (i, slot) in rhs.iter_mut().enumerate().take(n).skip(2) {
         let v = nodes.velocity[i];
         let (force, inverse_mass) = (loads.forces[i], nodes.inverse_mass[i]);
         let a = (loads.external).acceleration(force, v, inverse_mass, loads.accelerations, i);
-        *slot = ((v + a * h) * loads.mass[i]).components();
+        let momentum = (v + a * h) * loads.mass[i];
+        explicit_momentum += momentum;
+        *slot = momentum.components();
     }
     BendingSystem::move_held_nodes(frames, loads.rest, h, held_velocity, &mut rhs);
     system.solve(&mut rhs);
+    let mut momentum = P::V::ZERO;
     for (i, solved) in rhs.iter().enumerate().take(n).skip(2) {
         let (v, x) = (P::V::from_components(*solved), nodes.position[i]);
+        momentum += v * loads.mass[i];
         nodes.velocity[i] = P::V::select(active, v, nodes.velocity[i]);
         nodes.position[i] = P::V::select(active, x + v * h, x);
     }
+    on_held_nodes::<P, N>(loads.forces, momentum - explicit_momentum, h)
+}
+
+/// The mean force on the held nodes 0 and 1 over an implicit step: their elastic forces
+/// `F_0 + F_1` and their share of the implicit term, `−h (H̃ v⁺)_{0,1}`. `H̃` is built from
+/// gradients of a translation-invariant energy, so its columns sum to zero and the held rows'
+/// share is minus the free rows': `h Σ_free (H̃ v⁺)_i = −(Σ_free m_i v⁺_i − Σ_free m_i (v_i +
+/// h a_i))`, the momentum the implicit term took from the free nodes (`implicit_change`).
+fn on_held_nodes<P: Kernel, const N: usize>(
+    forces: &[P::V; N],
+    implicit_change: P::V,
+    h: P::R,
+) -> P::V {
+    crate::root_coupling::elastic_on_root::<P, N>(forces) - implicit_change * (P::R::ONE / h)
 }
 
 #[cfg(test)]

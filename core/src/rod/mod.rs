@@ -64,13 +64,18 @@ impl ClampedSegments {
     /// The clamped set of strand `strand_index` (`nodes` nodes) under `grabs`: the root, plus
     /// for each held grab of a node `g ≥ 2` of this strand the segment `e^g` that starts at it
     /// (`e^{g−1}` for the tip node). Grabs beyond [`MAX_CLAMPED`] are not clamped (they still
-    /// pin their node in the projection).
+    /// pin their node in the projection). A coupled grab clamps nothing: its spring holds a
+    /// point, which turns freely.
     #[must_use]
     pub fn from_grabs(grabs: &[Grab], strand_index: u32, nodes: usize) -> ClampedSegments {
         let mut set = ClampedSegments::ROOT_ONLY;
         for grab in grabs {
             let node = grab.node as usize;
-            if grab.strand != strand_index || grab.status != GrabStatus::Held || node >= nodes {
+            if grab.strand != strand_index
+                || grab.status != GrabStatus::Held
+                || grab.is_coupled()
+                || node >= nodes
+            {
                 continue;
             }
             let segment = if node + 1 < nodes {

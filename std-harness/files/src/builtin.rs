@@ -6,7 +6,7 @@
 //! (`mannequin-a`: 15,000 strands, ~349,000 vertices; `mannequin-b`: 500 strands, 8,000
 //! vertices; both with DFTL + shape + hair–hair, the table's third column).
 
-use hairsim_core::scenes::{firmware, firmware_dftl};
+use hairsim_core::scenes::{firmware, firmware_dftl, haptic_dftl};
 use hairsim_core::{DefaultMath, Math, Params, Shake, World};
 
 use crate::scene::generate::{self, Style};
@@ -40,6 +40,11 @@ pub const BUILTINS: &[Builtin] = &[
         name: "firmware-dftl",
         about: "the firmware example's DFTL scene: 8 wavy strands with shape and gusty wind on a 5 cm head shaking at 10 rad/s above a floor, 1000 steps at 1 ms (same hash as under QEMU)",
         scene: firmware_dftl_scene,
+    },
+    Builtin {
+        name: "haptic-dftl",
+        about: "a haptic device holds a DFTL strand's tip through a virtual coupling (50 N/m) on a 1 cm circle at 2 Hz: 8 wavy strands of 16 nodes with shape on a 5 cm head shaking at 10 rad/s, 1000 steps at 1 ms (same hash as under QEMU)",
+        scene: haptic_dftl_scene,
     },
     Builtin {
         name: "stand-1",
@@ -178,24 +183,42 @@ pub fn firmware_scene() -> Scene {
     // scene would be refused by its check ("no strands"), never run half-built.
     let _ = firmware::build(&mut world);
     let mut scene = from_world("firmware", &world, u64::from(firmware::STEPS));
-    // `firmware::grab_target`: a 1 cm circle at 2 Hz in the x–z plane from the tip's rest
-    // position (the target before step k is the circle at t = (k + 1) dt, as here).
-    if let Some(grab) = world.grabs().first() {
-        scene.grabs = vec![GrabSpec {
-            strand: grab.strand,
-            node: grab.node,
-            force_limit: grab.force_limit,
-            path: None,
-            circle: Some(crate::scene::CircleSpec {
-                start: grab.target.to_array(),
-                radius: 0.01,
-                frequency: 2.0,
-                u: None,
-                v: None,
-            }),
-            release: None,
-        }];
+    scene.grabs = world.grabs().iter().map(circling).collect();
+    scene
+}
+
+/// A firmware scene's grab as a scene's: `firmware::grab_target` and
+/// `haptic_dftl::grab_target` go round a 1 cm circle at 2 Hz in the x–z plane from the grab's
+/// first target (the target before step k is the circle at t = (k + 1) dt, as here).
+fn circling(grab: &hairsim_core::Grab) -> GrabSpec {
+    GrabSpec {
+        strand: grab.strand,
+        node: grab.node,
+        force_limit: grab.force_limit,
+        coupling: grab.coupling.map(|c| crate::scene::CouplingSpec {
+            stiffness: c.stiffness,
+            damping: c.damping,
+        }),
+        path: None,
+        circle: Some(crate::scene::CircleSpec {
+            start: grab.target.to_array(),
+            radius: 0.01,
+            frequency: 2.0,
+            u: None,
+            v: None,
+        }),
+        release: None,
     }
+}
+
+/// The haptic DFTL scene, from `hairsim_core::scenes::haptic_dftl`.
+#[must_use]
+pub fn haptic_dftl_scene() -> Scene {
+    let mut world: Box<World<{ haptic_dftl::STRANDS }, { haptic_dftl::NODES }, DefaultMath>> =
+        Box::default();
+    let _ = haptic_dftl::build(&mut world);
+    let mut scene = from_world("haptic-dftl", &world, u64::from(haptic_dftl::STEPS));
+    scene.grabs = world.grabs().iter().map(circling).collect();
     scene
 }
 
@@ -442,6 +465,7 @@ fn haptic() -> Scene {
         strand: 0,
         node: grabbed,
         force_limit: 0.05,
+        coupling: None,
         path: Some(vec![
             PathKey {
                 time: 0.0,

@@ -431,10 +431,14 @@ pub struct StrandSpec {
 pub struct GrabSpec {
     /// Strand index (in build order: `hair` strands first, then `[[strands]]`).
     pub strand: u32,
-    /// Node index (≥ 2; the last node with DFTL).
+    /// Node index (2 to the strand's last).
     pub node: u32,
     /// Force at which the grab slips, N.
     pub force_limit: f32,
+    /// A virtual coupling pulling the node toward the target (default none: the node is
+    /// held at the target and slips when the target leaves the strand's reach).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub coupling: Option<CouplingSpec>,
     /// Target path: keys in increasing time, linear between them, held after the last (give
     /// this or `circle`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -445,6 +449,18 @@ pub struct GrabSpec {
     /// Time the grab lets go, s (default never).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub release: Option<f32>,
+}
+
+/// A grab's virtual coupling: a spring and a damper between the target and the node
+/// (`hairsim_core::Coupling`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CouplingSpec {
+    /// Spring stiffness, N/m.
+    pub stiffness: f32,
+    /// Damping, N·s/m (default 0).
+    #[serde(default)]
+    pub damping: f32,
 }
 
 /// A grab target going round a circle from `start`:

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use hairsim_core::params::{DftlParams, RodParams, TwistMethod, WindParams};
 use hairsim_core::{
-    Collider, Effect, Effects, Material, Mode, ParamError, Params, Real, Shake, Shape, Solver,
-    Strand, Vec3,
+    Collider, Coupling, Effect, Effects, Material, Mode, ParamError, Params, Real, Shake, Shape,
+    Solver, Strand, Vec3,
 };
 
 use super::error::FieldError;
@@ -46,6 +46,8 @@ pub struct GrabPlan {
     pub node: u32,
     /// N.
     pub force_limit: Real,
+    /// The virtual coupling, if any.
+    pub coupling: Option<Coupling>,
     /// Target path and release.
     pub path: GrabPath,
 }
@@ -175,7 +177,7 @@ pub fn prepare(scene: &Scene, files: HairFiles<'_>) -> Result<Prepared, FieldErr
     strands.extend(listed_strands(scene, &base_material, base_tip));
     check_polylines(&strands)?;
     let colliders = colliders(scene);
-    let grabs = grabs(scene, &strands, solver)?;
+    let grabs = grabs(scene, &strands)?;
     // Last, so that the scene's own checks (which name their fields) speak first.
     params.validate().map_err(param_field)?;
     check_time_step(&params, &strands)?;
@@ -459,14 +461,15 @@ fn collider_shape(c: &ColliderSpec) -> Shape {
 }
 
 /// The `[[grabs]]`, each checked against the strand it holds.
-fn grabs(scene: &Scene, strands: &[RestSpec], solver: Solver) -> Result<Vec<GrabPlan>, FieldError> {
+fn grabs(scene: &Scene, strands: &[RestSpec]) -> Result<Vec<GrabPlan>, FieldError> {
     let mut grabs = Vec::with_capacity(scene.grabs.len());
     for (i, g) in scene.grabs.iter().enumerate() {
-        check_grab(&format!("grabs[{i}]"), g, strands, solver)?;
+        check_grab(&format!("grabs[{i}]"), g, strands)?;
         grabs.push(GrabPlan {
             strand: g.strand,
             node: g.node,
             force_limit: g.force_limit,
+            coupling: g.coupling.map(|c| Coupling::new(c.stiffness, c.damping)),
             path: GrabPath {
                 path: grab_path(g),
                 release: g.release,
@@ -476,13 +479,8 @@ fn grabs(scene: &Scene, strands: &[RestSpec], solver: Solver) -> Result<Vec<Grab
     Ok(grabs)
 }
 
-/// A grab holds an existing strand at a free node (DFTL: at the tip only).
-fn check_grab(
-    f: &str,
-    g: &GrabSpec,
-    strands: &[RestSpec],
-    solver: Solver,
-) -> Result<(), FieldError> {
+/// A grab holds an existing strand at a free node.
+fn check_grab(f: &str, g: &GrabSpec, strands: &[RestSpec]) -> Result<(), FieldError> {
     let Some(strand) = strands.get(g.strand as usize) else {
         return Err(FieldError::new(
             format!("{f}.strand"),
@@ -500,15 +498,6 @@ fn check_grab(
             format!(
                 "node {} is not a free node of strand {}, allowed 2 to {last}",
                 g.node, g.strand
-            ),
-        ));
-    }
-    if solver == Solver::Dftl && g.node != last {
-        return Err(FieldError::new(
-            format!("{f}.node"),
-            format!(
-                "the dftl solver cannot grab mid-strand (node {}), allowed the tip, node {last}",
-                g.node
             ),
         ));
     }

@@ -71,7 +71,13 @@ impl Prepared {
     pub fn start_grabs<M: Math>(&self) -> Vec<Grab> {
         self.grabs
             .iter()
-            .map(|g| Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit))
+            .map(|g| {
+                let grab = Grab::new(g.strand, g.node, g.path.target_at::<M>(0.0), g.force_limit);
+                match g.coupling {
+                    Some(coupling) => grab.with_coupling(coupling),
+                    None => grab,
+                }
+            })
             .collect()
     }
 }

@@ -2,7 +2,7 @@
 //! fields go together. Each failure names its field and says what is allowed.
 
 use hairsim_core::params::{MAX_DT, MIN_DT};
-use hairsim_core::{Effect, Solver};
+use hairsim_core::{Coupling, Effect, Solver};
 
 use super::error::FieldError;
 use super::{
@@ -749,6 +749,23 @@ fn grabs(list: &[GrabSpec]) -> Check {
     for (i, g) in list.iter().enumerate() {
         let f = format!("grabs[{i}]");
         positive(&format!("{f}.force_limit"), g.force_limit, 1000.0, " N")?;
+        if let Some(c) = &g.coupling {
+            let ((k_low, k_high), (b_low, b_high)) = (Coupling::STIFFNESS, Coupling::DAMPING);
+            range(
+                &format!("{f}.coupling.stiffness"),
+                c.stiffness,
+                k_low,
+                k_high,
+                " N/m",
+            )?;
+            range(
+                &format!("{f}.coupling.damping"),
+                c.damping,
+                b_low,
+                b_high,
+                " N·s/m",
+            )?;
+        }
         match (&g.path, &g.circle) {
             (Some(_), Some(_)) => {
                 return fail(
