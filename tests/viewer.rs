@@ -193,7 +193,7 @@ fn effects_a_scene_cannot_use_say_why() {
 }
 
 /// hairsim's own `.obj`, `.ply` and `.usda` exports run as hair files: by path in `hairsim
-/// run` and dropped on the page as bytes, with the same bits.
+/// run`, named by a scene file, and dropped on the page as bytes, with the same bits.
 #[test]
 fn hairsims_text_exports_run_as_hair_files() {
     let loaded = load("head-1", &HairFileOptions::default()).unwrap();
@@ -213,11 +213,28 @@ fn hairsims_text_exports_run_as_hair_files() {
         let page = viewer_hash(
             Source::HairFile {
                 name: name.clone(),
-                bytes,
+                bytes: bytes.clone(),
             },
             20,
         );
         assert_eq!(page, native_hash(path.to_str().unwrap(), 20), "{name}");
+        let scene = format!(
+            "format = 1\nname = \"from-{format}\"\nsolver = \"dftl\"\ndt = 0.001\nsteps = 20\n\
+             effects = [\"gravity\", \"inextensibility\", \"shape\"]\n\n[hair.file]\npath = \"{name}\"\n"
+        );
+        assert_eq!(
+            hairsim_viewer::session::scene_hair_file("s.toml", &scene).unwrap(),
+            Some(name.clone())
+        );
+        let source = Source::SceneFile {
+            name: "s.toml".into(),
+            text: scene,
+            hair: Some((name.clone(), bytes)),
+        };
+        assert!(
+            Session::load(source).is_ok(),
+            "{name} named by a scene file"
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }

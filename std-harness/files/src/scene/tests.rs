@@ -483,12 +483,12 @@ fn hair_errors() {
     refused(
         &[],
         &file("path = \"\"\n"),
-        "t.toml:13: hair.file.path: empty, allowed the path of a .hair or .tfx file",
+        "t.toml:13: hair.file.path: empty, allowed the path of a hair file",
     );
     refused(
         &[],
         &file("path = \"a.txt\"\n"),
-        "t.toml:13: hair.file.path: \"a.txt\" is not a hair file, allowed a .hair or .tfx file",
+        "t.toml:13: hair.file.path: \"a.txt\" is not a hair file, allowed a .hair, .tfx, .obj, .ply or .usda file",
     );
     refused(
         &[],

@@ -643,15 +643,15 @@ fn hair(scene: &Scene) -> Check {
             if file.path.is_empty() {
                 return fail(
                     format!("{f}.path"),
-                    "empty, allowed the path of a .hair or .tfx file",
+                    "empty, allowed the path of a hair file",
                 );
             }
-            let lower = file.path.to_ascii_lowercase();
-            if !(lower.ends_with(".hair") || lower.ends_with(".tfx")) {
+            if !crate::hairfile::is_hair_file(&file.path) {
                 return fail(
                     format!("{f}.path"),
                     format!(
-                        "\"{}\" is not a hair file, allowed a .hair or .tfx file",
+                        "\"{}\" is not a hair file, allowed a .hair, .tfx, .obj, .ply or .usda \
+                         file",
                         file.path
                     ),
                 );
