@@ -10,7 +10,7 @@
 //! writers and readers of [`export`]) are the crate `hairsim-files`, re-exported here at the
 //! same paths.
 
-pub use hairsim_files::{builtin, hairfile, hairscene, scene};
+pub use hairsim_files::{builtin, hairfile, hairscene, lanes, scene};
 
 pub mod cmd;
 pub mod export;

@@ -13,13 +13,13 @@
 //! state anyone reads or writes.
 
 use hairsim_core::context::StepContext;
-use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
+use hairsim_core::dftl::DftlBlock;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::step_strands_with;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
     step_strands, step_strands_in_blocks, step_strands_in_lanes_with, Collider, Grab, Math, Params,
-    Pose, Real, RodBlockScratch, RodScratch, Solver, Stage, StepReport, Strand, Vec3,
+    Pose, RodBlockScratch, RodScratch, Solver, Stage, StepReport, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -28,33 +28,8 @@ use crate::sph::Sph;
 
 pub use crate::scene::start::{scene_inputs, time_after, StepInputs};
 
-/// Lanes of the DFTL blocks.
-const LANES: usize = RECOMMENDED_LANES;
-/// Lanes of the rod's blocks (`hairsim_core::pipeline::rod::step_block`).
-const ROD_LANES: usize = 4;
-
-/// The backend `M` with the hardware's square root, which the compiler can vectorise
-/// (`libm::sqrtf` is a scalar `sqrtss`). [`Math::sqrt`] is correctly rounded in every backend
-/// and so is `f32::sqrt`: the same bits; the trigonometry stays `M`'s.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct VectorSqrt<M>(std::marker::PhantomData<M>);
-
-impl<M: Math> Math for VectorSqrt<M> {
-    const NAME: &'static str = M::NAME;
-    const PLAIN_TRIGONOMETRY: bool = M::PLAIN_TRIGONOMETRY;
-    #[inline(always)]
-    fn sqrt(x: Real) -> Real {
-        x.sqrt()
-    }
-    #[inline(always)]
-    fn sin_cos(x: Real) -> (Real, Real) {
-        M::sin_cos(x)
-    }
-    #[inline(always)]
-    fn atan2(y: Real, x: Real) -> Real {
-        M::atan2(y, x)
-    }
-}
+pub use crate::lanes::VectorSqrt;
+use crate::lanes::{DFTL_LANES as LANES, ROD_LANES};
 
 /// How a simulation steps its strands: the bits are the same either way, only the speed
 /// differs (the golden hashes pin both).

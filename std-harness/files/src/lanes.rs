@@ -40,21 +40,5 @@ impl<M: Math> Math for VectorSqrt<M> {
 /// loaded into (lane `l` from `strands[l]`): the inverse of [`DftlBlock::store`]. The rest
 /// data stays as loaded.
 pub fn load_state<const N: usize>(block: &mut DftlBlock<DFTL_LANES, N>, strands: &[Strand<N>]) {
-    for (l, strand) in strands
-        .iter()
-        .enumerate()
-        .take(block.strands.min(DFTL_LANES))
-    {
-        let n = block.nodes[l].min(N);
-        for (lanes, (x, v)) in block.state.iter_mut().zip(
-            strand.state.position[..n]
-                .iter()
-                .zip(&strand.state.velocity[..n]),
-        ) {
-            for (axis, (p, u)) in x.to_array().into_iter().zip(v.to_array()).enumerate() {
-                lanes.position[axis][l] = p;
-                lanes.velocity[axis][l] = u;
-            }
-        }
-    }
+    block.load_state(strands);
 }
