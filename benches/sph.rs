@@ -4,13 +4,17 @@
 //! DFTL + shape + hair–hair, on one and two threads, with the split of the SPH stage's time among
 //! hash, sort (counting sort + rearranging), neighbour search (with density) and forces.
 //!
-//! Each configuration runs `WARM_UP` steps (the hair leaves its combed start and the neighbour
-//! lists reach their working size), then times `STEPS` steps by the wall clock and by the
+//! Each configuration runs half a second of warm-up (the hair leaves its combed start and the
+//! neighbour lists reach their working size), then times `STEPS` steps — enough for the
+//! candidate lists' rebuilds to be counted at their rate — by the wall clock and by the
 //! process's CPU time (`/proc/self/stat`; on a shared machine the CPU figure is the steadier).
+//! The SPH line gives the stage's split, its rebuilds per 100 steps and the particles with a
+//! candidate.
 //!
 //! `cargo bench -p hairsim-benches --bench sph` (everything), or picking scenes, columns and
 //! thread counts by name: `cargo bench -p hairsim-benches --bench sph -- mannequin-a
-//! dftl+shape+hair-hair 2t`. With `stage`, the SPH stage alone on the picked sizes (after the
+//! dftl+shape+hair-hair 2t`; `dt=0.001` runs the scenes at another step (1 ms, the
+//! project's rate) than their own 1/60 s. With `stage`, the SPH stage alone on the picked sizes (after the
 //! warm-up, its accelerations computed again and again on one state, on one and two threads:
 //! the fastest of `STAGE_REPEATS` per phase — the least disturbed by other processes — and the
 //! CPU time of all of them). Under
@@ -23,10 +27,10 @@ use hairsim::sim::{scene_inputs, Sim, StepInputs};
 use hairsim_benches::cpu_seconds;
 use hairsim_core::DefaultMath;
 
-/// Steps before timing (0.5 s of the scene at 1/60 s).
-const WARM_UP: u64 = 30;
+/// Seconds of the scene before timing.
+const WARM_UP_SECONDS: f32 = 0.5;
 /// Steps timed.
-const STEPS: u64 = 20;
+const STEPS: u64 = 300;
 
 /// Times the SPH stage runs on one state with `stage`.
 const STAGE_REPEATS: usize = 15;
@@ -73,10 +77,13 @@ const SIZES: &[Size] = &[
 /// Table 1's columns.
 const COLUMNS: &[&str] = &["dftl", "dftl+shape", "dftl+shape+hair-hair"];
 
-/// The mannequin scene (DFTL + shape + hair–hair) with `size`'s strands and nodes, and the
-/// effects of `column`.
-fn scene(size: &Size, column: &str) -> Prepared {
+/// The mannequin scene (DFTL + shape + hair–hair) with `size`'s strands and nodes, the effects
+/// of `column`, at a step of `dt` (the scene's own when `None`).
+fn scene(size: &Size, column: &str, dt: Option<f32>) -> Prepared {
     let mut scene: Scene = (hairsim::builtin::find("mannequin-a").unwrap().scene)();
+    if let Some(dt) = dt {
+        scene.dt = dt;
+    }
     if let Some(HairSpec::Scalp(scalp)) = &mut scene.hair {
         scalp.leaders = size.strands;
         scalp.nodes = size.nodes;
@@ -89,8 +96,17 @@ fn scene(size: &Size, column: &str) -> Prepared {
     scene.prepare().unwrap()
 }
 
-fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, steps: u64) {
-    let prepared = scene(size, column);
+/// How a run goes: the step (the scene's own when `None`), steps of warm-up and timed.
+#[derive(Clone, Copy)]
+struct Timing {
+    dt: Option<f32>,
+    warm_up: u64,
+    steps: u64,
+}
+
+fn run<const N: usize>(size: &Size, column: &str, threads: usize, timing: Timing) {
+    let Timing { dt, warm_up, steps } = timing;
+    let prepared = scene(size, column, dt);
     let inputs: Vec<StepInputs> = (0..warm_up + steps)
         .map(|k| scene_inputs::<DefaultMath>(&prepared, k))
         .collect();
@@ -110,7 +126,7 @@ fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, 
             let s = &sph.stats;
             let ms = |t: Duration| t.as_secs_f64() * 1e3 / steps as f64;
             format!(
-                "  sph ms/step: hash {:.2}, sort {:.2}, neighbours {:.2}, forces {:.2}; {:.1} neighbours/node (cap {}, {:.1} dropped/node, most found {})",
+                "  sph ms/step: hash {:.3}, sort {:.3}, neighbours {:.3}, forces {:.3}; {:.2} neighbours/node (cap {}, {:.1} dropped/node, most found {}); {:.1} rebuilds per 100 steps, {:.3} active/node, {:.2} candidates/node",
                 ms(s.time_hash - b.time_hash),
                 ms(s.time_sort - b.time_sort),
                 ms(s.time_neighbours - b.time_neighbours),
@@ -119,6 +135,9 @@ fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, 
                 sph.params().neighbour_cap,
                 (s.truncated - b.truncated) as f64 / (steps as f64 * vertices as f64),
                 s.max_neighbours_found,
+                (s.rebuilds - b.rebuilds) as f64 * 100.0 / steps as f64,
+                (s.active - b.active) as f64 / (steps as f64 * vertices as f64),
+                (s.candidates - b.candidates) as f64 / (steps as f64 * vertices as f64),
             )
         });
         (wall, cpu, split)
@@ -126,7 +145,7 @@ fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, 
     assert!(sim.is_finite(), "{} {column}: not finite", size.name);
     let work = vertices as f64 * steps as f64 / 1e6;
     println!(
-        "{:<12} {:>8} vertices {:<16} {} thread(s): {:>7.2} M vertex-steps/s wall, {:>7.2} M/CPU-s, {:>8.2} ms/step{}",
+        "{:<12} {:>8} vertices {:<16} {} thread(s): {:>7.2} M vertex-steps/s wall, {:>7.2} M/CPU-s, {:>8.3} ms/step, dt {:.4} s{}",
         size.name,
         vertices,
         column,
@@ -134,13 +153,14 @@ fn run<const N: usize>(size: &Size, column: &str, threads: usize, warm_up: u64, 
         work / wall,
         work / cpu.max(0.01),
         wall * 1e3 / steps as f64,
+        prepared.params.dt,
         split.unwrap_or_default()
     );
 }
 
 /// The SPH stage alone on `size`'s warmed-up state, on one and two threads.
 fn stage<const N: usize>(size: &Size, warm_up: u64, repeats: usize) {
-    let prepared = scene(size, "dftl+shape+hair-hair");
+    let prepared = scene(size, "dftl+shape+hair-hair", None);
     let mut sim = Sim::<N, DefaultMath>::new(&prepared, 2).unwrap();
     sim.in_pool(|sim| {
         for k in 0..warm_up {
@@ -148,22 +168,21 @@ fn stage<const N: usize>(size: &Size, warm_up: u64, repeats: usize) {
         }
     });
     let dt = prepared.params.dt;
-    let mut acc = vec![hairsim_core::Vec3::ZERO; sim.strands.len() * N];
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap();
         let mut sph = sim.sph.clone().unwrap();
-        let strands = &sim.strands;
+        let (strands, head) = (&sim.strands, sim.head);
         let (phases, cpu, wall) = pool.install(|| {
-            sph.accelerations(strands, dt, &mut acc);
+            sph.accelerations(strands, dt, head);
             let mut phases = [f64::INFINITY; 5];
             let (cpu0, wall0) = (cpu_time::ProcessTime::now(), Instant::now());
             for _ in 0..repeats {
                 let b = sph.stats.clone();
                 let t = Instant::now();
-                sph.accelerations(strands, dt, &mut acc);
+                sph.accelerations(strands, dt, head);
                 let total = t.elapsed();
                 let s = &sph.stats;
                 let times = [
@@ -209,7 +228,15 @@ fn main() {
     // sizes run two steps each, as a test that the benchmark works, not a measurement.
     let quick = !args.iter().any(|a| a == "--bench");
     let filter: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
-    let (warm_up, steps) = if quick { (1, 1) } else { (WARM_UP, STEPS) };
+    let number = |name: &str| {
+        filter
+            .iter()
+            .find_map(|f| f.strip_prefix(name)?.parse::<f64>().ok())
+    };
+    let dt = number("dt=").map(|dt| dt as f32);
+    let warm_up = (WARM_UP_SECONDS / dt.unwrap_or(1.0 / 60.0)).round() as u64;
+    let (warm_up, steps) = if quick { (1, 1) } else { (warm_up, STEPS) };
+    let timing = Timing { dt, warm_up, steps };
     for size in SIZES {
         if quick && size.strands * size.nodes > 10_000 {
             continue;
@@ -227,12 +254,7 @@ fn main() {
         if filter.iter().any(|f| f.as_str() == "stage") {
             let repeats = if quick { 1 } else { STAGE_REPEATS };
             // `warm-up=K` and `repeats=R` (for a run under a profiler or valgrind).
-            let number = |name: &str| {
-                filter
-                    .iter()
-                    .find_map(|f| f.strip_prefix(name)?.parse::<u64>().ok())
-            };
-            let warm_up = number("warm-up=").unwrap_or(warm_up);
+            let warm_up = number("warm-up=").map_or(warm_up, |w| w as u64);
             let repeats = number("repeats=").map_or(repeats, |r| r as usize);
             match size.nodes {
                 0..=16 => stage::<16>(size, warm_up, repeats),
@@ -249,8 +271,8 @@ fn main() {
                     continue;
                 }
                 match size.nodes {
-                    0..=16 => run::<16>(size, column, threads, warm_up, steps),
-                    _ => run::<32>(size, column, threads, warm_up, steps),
+                    0..=16 => run::<16>(size, column, threads, timing),
+                    _ => run::<32>(size, column, threads, timing),
                 }
             }
         }

@@ -63,7 +63,6 @@ pub struct Sim<const N: usize, M: Math> {
     /// strand order (rest data loaded once; the state copied in and out every step).
     dftl_blocks: Vec<DftlBlock<LANES, N>>,
     dftl: DftlCoefficients,
-    accelerations: Vec<Vec3>,
     /// One report per block of strands, reused every step (a step allocates nothing).
     block_reports: Vec<StepReport>,
     /// The rod's scratch space of each block of strands, kept from step to step (none for
@@ -124,11 +123,6 @@ impl<const N: usize, M: Math> Sim<N, M> {
             params: prepared.params,
             block_reports: vec![StepReport::default(); blocks],
             rod_scratch,
-            accelerations: if sph.is_some() {
-                vec![Vec3::ZERO; strands.len() * N]
-            } else {
-                Vec::new()
-            },
             strands,
             colliders: prepared.colliders.clone(),
             grabs,
@@ -201,17 +195,22 @@ impl<const N: usize, M: Math> Sim<N, M> {
         report
     }
 
-    /// The SPH stage, when `hair-hair` is on and set up: every node's acceleration into
-    /// `self.accelerations`, counted like the core's stages (the strands it ran on). Returns
+    /// The SPH stage, when `hair-hair` is on and set up: every node's acceleration into the
+    /// stage's output ([`Sph::output`]), counted like the core's stages (the strands it ran on). Returns
     /// whether it ran.
     fn hair_hair(&mut self, ctx: &StepContext, report: &mut StepReport) -> bool {
         let Some(sph) = self.sph.as_mut().filter(|_| ctx.gates.hair_hair) else {
             return false;
         };
-        let (strands, out, dt) = (&self.strands, &mut self.accelerations, ctx.dt);
+        // The strands' state is the previous step's end: the head was at its previous pose.
+        let (strands, dt, head) = (&self.strands, ctx.dt, ctx.previous_head);
         match &self.pool {
-            Some(pool) => pool.install(|| sph.accelerations(strands, dt, out)),
-            None => sph.accelerations(strands, dt, out),
+            Some(pool) => pool.install(|| {
+                sph.accelerations(strands, dt, head);
+            }),
+            None => {
+                sph.accelerations(strands, dt, head);
+            }
         }
         report.ran_on(
             Stage::HairHair,
@@ -228,7 +227,11 @@ impl<const N: usize, M: Math> Sim<N, M> {
             ctx,
             block: self.block,
             grabs: &self.grabs,
-            accelerations: hair_hair.then_some(self.accelerations.as_slice()),
+            accelerations: self
+                .sph
+                .as_ref()
+                .filter(|_| hair_hair)
+                .map(|s| (s.output(), s.acting())),
         };
         let reports = &mut self.block_reports;
         let parallel = self.pool.as_ref().filter(|_| reports.len() > 1);
@@ -245,12 +248,12 @@ impl<const N: usize, M: Math> Sim<N, M> {
 }
 
 /// What every block of a step shares: the context, the block size, the grabs and the
-/// accelerations of all strands.
+/// accelerations of all strands with whether any acts on each strand.
 struct Blocks<'a> {
     ctx: &'a StepContext,
     block: usize,
     grabs: &'a [Grab],
-    accelerations: Option<&'a [Vec3]>,
+    accelerations: Option<(&'a [Vec3], &'a [bool])>,
 }
 
 /// The rod's scratch space of one block of strands: the lanes' (with the lanes' square root,
@@ -276,11 +279,17 @@ impl<M: Math, const N: usize> KeptScratch<M, N> {
 }
 
 impl Blocks<'_> {
-    /// The accelerations of block `b` of `strands` strands.
+    /// The accelerations of block `b` of `strands` strands; none where no node of the block
+    /// has a neighbour (the step then runs without the input, as it does without hair–hair).
     fn of_block<const N: usize>(&self, b: usize, strands: usize) -> Option<&[Vec3]> {
         let first = b * self.block;
-        self.accelerations
-            .and_then(|a| a.get(first * N..(first + strands) * N))
+        let (accelerations, acting) = self.accelerations?;
+        acting
+            .get(first..first + strands)?
+            .iter()
+            .any(|&a| a)
+            .then(|| accelerations.get(first * N..(first + strands) * N))
+            .flatten()
     }
 
     /// Every block of `strands` through the core's per-strand pipeline, the rod's in lanes

@@ -14,103 +14,18 @@
 //! The implicit form reduces to the explicit one when `Δt µ D/ρ ≪ 1` and, for any µ, damps the
 //! relative velocity of neighbours without ever reversing it.
 //!
-//! Each particle's sums run over its list in order, so the bits do not depend on threads. What a
-//! neighbour contributes is read from one packed record of 32 bytes (position, `m/ρ`,
-//! velocity, pressure), half a cache line, so a neighbour costs one memory access.
+//! Each particle's sums are taken with the same bits in any order of its neighbours
+//! ([`super::sum`]). What a neighbour contributes is read from one packed record of 32 bytes
+//! (position, `m/ρ`, velocity, pressure), half a cache line, so a neighbour costs one memory
+//! access.
 
 use std::f32::consts::PI;
 
 use hairsim_core::Vec3;
 use rayon::prelude::*;
 
-use super::neighbours::{NeighbourLists, PADDING};
-use super::{SphParams, CHUNK};
-
-/// What the hash pass reads of each particle (32 bytes), gathered into the sorted order.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Record {
-    /// Position, m.
-    pub position: [f32; 3],
-    /// Velocity, m/s.
-    pub velocity: [f32; 3],
-    /// Mass, kg.
-    pub mass: f32,
-    /// `strand << NODE_BITS | node`.
-    pub key: u32,
-}
-
-/// Particles rearranged into the grid's sorted order, and what is computed for them.
-#[derive(Clone, Debug, Default)]
-pub struct SortedParticles {
-    /// Velocities, m/s.
-    pub velocity: Vec<[f32; 3]>,
-    /// Positions, m: x (and [`PADDING`] entries past the last particle, never a neighbour).
-    pub x: Vec<f32>,
-    /// Positions, m: y.
-    pub y: Vec<f32>,
-    /// Positions, m: z.
-    pub z: Vec<f32>,
-    /// Masses, kg.
-    pub mass: Vec<f32>,
-    /// Keys: `strand << NODE_BITS | node`.
-    pub key: Vec<u32>,
-    /// Densities, kg/m³.
-    pub density: Vec<f32>,
-    /// What a neighbour contributes: `[x, y, z, m/ρ, vx, vy, vz, p]`.
-    pub packed: Vec<[f32; 8]>,
-    /// Accelerations, m/s².
-    pub acceleration: Vec<Vec3>,
-}
-
-impl SortedParticles {
-    /// Buffers for `n` particles.
-    #[must_use]
-    pub fn new(n: usize) -> SortedParticles {
-        SortedParticles {
-            velocity: vec![[0.0; 3]; n],
-            x: vec![0.0; n + PADDING],
-            y: vec![0.0; n + PADDING],
-            z: vec![0.0; n + PADDING],
-            mass: vec![0.0; n],
-            key: vec![0; n],
-            density: vec![0.0; n],
-            packed: vec![[0.0; 8]; n],
-            acceleration: vec![Vec3::ZERO; n],
-        }
-    }
-
-    /// Position of sorted particle `k`.
-    #[must_use]
-    pub fn position(&self, k: usize) -> Vec3 {
-        Vec3::new(self.x[k], self.y[k], self.z[k])
-    }
-
-    /// Fills the sorted arrays: sorted particle `k` is `record[order[k]]` (Algorithm 1
-    /// line 5), chunk by chunk in parallel — each record read once, each array written in
-    /// order.
-    pub fn gather(&mut self, order: &[u32], record: &[Record]) {
-        let n = order.len().min(self.velocity.len());
-        (
-            self.x[..n].par_chunks_mut(CHUNK),
-            self.y[..n].par_chunks_mut(CHUNK),
-            self.z[..n].par_chunks_mut(CHUNK),
-            self.velocity[..n].par_chunks_mut(CHUNK),
-            self.mass[..n].par_chunks_mut(CHUNK),
-            self.key[..n].par_chunks_mut(CHUNK),
-        )
-            .into_par_iter()
-            .enumerate()
-            .for_each(|(c, (x, y, z, v, m, key))| {
-                for (k, &p) in order[c * CHUNK..].iter().take(x.len()).enumerate() {
-                    let Some(r) = record.get(p as usize) else {
-                        continue;
-                    };
-                    [x[k], y[k], z[k]] = r.position;
-                    (v[k], m[k], key[k]) = (r.velocity, r.mass, r.key);
-                }
-            });
-    }
-}
+use super::density::Neighbours;
+use super::{sum, SphParams, CHUNK, MAX_CAP};
 
 /// `315/(64π h⁹)`.
 #[inline]
@@ -140,44 +55,36 @@ pub fn spiky_viscosity_factor(h: f32) -> f32 {
     45.0 / (PI * h2 * h2 * h2)
 }
 
-/// Pressure and viscosity accelerations of every particle, for a step of `dt` seconds.
-pub fn accelerations(p: &mut SortedParticles, lists: &NeighbourLists, params: &SphParams, dt: f32) {
+/// Pressure and viscosity accelerations of every active particle into `acceleration`, for a
+/// step of `dt` seconds.
+pub fn accelerations(
+    neighbours: &Neighbours,
+    params: &SphParams,
+    dt: f32,
+    acceleration: &mut [Vec3],
+) {
     let h = params.smoothing_length;
     let factor = spiky_viscosity_factor(h);
     let mu = params.viscosity;
-    let (packed, density) = (&p.packed, &p.density);
-    p.acceleration
+    let (packed, density) = (&neighbours.packed, &neighbours.density);
+    acceleration
         .par_chunks_mut(CHUNK)
         .enumerate()
         .for_each(|(c, out)| {
+            let mut terms = [[0.0f32; sum::LANES]; MAX_CAP];
             for (i, acc) in out.iter_mut().enumerate() {
                 let a = c * CHUNK + i;
-                let me = packed[a];
-                let p_a = me[7];
-                let (mut fp, mut fv) = ([0.0f32; 3], [0.0f32; 3]);
-                let mut diagonal = 0.0;
-                for &b in lists.of(a) {
-                    let other = &packed[b as usize];
-                    let d = [me[0] - other[0], me[1] - other[1], me[2] - other[2]];
-                    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-                    let w = h - r;
-                    if w <= 0.0 {
-                        continue;
-                    }
-                    let q = other[3];
-                    if r > 0.0 {
-                        // −∇W_spiky points from b to a: repulsion.
-                        let s = q * (p_a + other[7]) * w * w / r;
-                        for k in 0..3 {
-                            fp[k] += d[k] * s;
-                        }
-                    }
-                    let laplacian = q * w;
-                    for k in 0..3 {
-                        fv[k] += (other[4 + k] - me[4 + k]) * laplacian;
-                    }
-                    diagonal += laplacian;
+                let list = neighbours.of(a);
+                if list.is_empty() {
+                    *acc = Vec3::ZERO;
+                    continue;
                 }
+                for (row, &b) in terms.iter_mut().zip(list) {
+                    *row = pair(&packed[a], &packed[b as usize], h);
+                }
+                let total = sum::lanes(&terms[..list.len()]);
+                let (fp, diagonal) = ([total[0], total[1], total[2]], total[3]);
+                let fv = [total[4], total[5], total[6]];
                 let rho = density[a];
                 let rate = mu / rho;
                 let implicit = rate * factor / (1.0 + dt * rate * factor * diagonal);
@@ -185,4 +92,34 @@ pub fn accelerations(p: &mut SortedParticles, lists: &NeighbourLists, params: &S
                 *acc = Vec3::from_array(fp) * pressure + Vec3::from_array(fv) * implicit;
             }
         });
+}
+
+/// What neighbour `other` adds to particle `me`'s sums, without the kernels' common factor:
+/// `[fp_x, fp_y, fp_z, D, fv_x, fv_y, fv_z, 0]` (zero beyond `h`, where rounding put it).
+#[inline(always)]
+fn pair(me: &[f32; 8], other: &[f32; 8], h: f32) -> [f32; sum::LANES] {
+    let d = [me[0] - other[0], me[1] - other[1], me[2] - other[2]];
+    let r = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    let w = h - r;
+    if w <= 0.0 {
+        return [0.0; sum::LANES];
+    }
+    let q = other[3];
+    // −∇W_spiky points from b to a: repulsion.
+    let s = if r > 0.0 {
+        q * (me[7] + other[7]) * w * w / r
+    } else {
+        0.0
+    };
+    let laplacian = q * w;
+    [
+        d[0] * s,
+        d[1] * s,
+        d[2] * s,
+        laplacian,
+        (other[4] - me[4]) * laplacian,
+        (other[5] - me[5]) * laplacian,
+        (other[6] - me[6]) * laplacian,
+        0.0,
+    ]
 }

@@ -170,6 +170,11 @@ impl Grid {
         self.inverse_cell
     }
 
+    /// Cells of `size` from now on (the buckets stay as they are).
+    pub fn set_cell(&mut self, size: f32) {
+        self.inverse_cell = 1.0 / size;
+    }
+
     /// How cells map to buckets.
     #[must_use]
     pub fn layout(&self) -> Layout {

@@ -1,37 +1,27 @@
-//! Capped neighbour lists (Sánchez-Banderas 2015, Sec. 4, Algorithm 1 line 6: the paper's
-//! rough k-nearest list), with the density and pressure of each particle (line 7) taken in
-//! the same pass, while the distances are at hand.
+//! Candidate lists (Sánchez-Banderas 2015, Sec. 4, Algorithm 1 line 6): each particle's
+//! list of the particles within `h + skin` of it, found through the grid ([`super::grid`]) in
+//! the frame the skin is measured in ([`super::skin`]), when the lists are rebuilt. Between
+//! rebuilds every step filters them by the distance `h` itself ([`super::density`]), so a
+//! step's neighbours do not depend on when the lists were built.
 //!
 //! Each particle's cell comes from its sorted position; the nine rows around it
 //! ([`RowsAround`]) are computed once per run of particles in one row, and the 27 cells are read
-//! as nine ranges of three cells (more where the row wraps around) of the
-//! sorted structure-of-arrays positions, looked up once per cell (the sorted particles of a
-//! cell are consecutive). Each range is tested where it lies, four candidates at a time for
-//! `r² < h²` (no square root; one packed compare on x86-64), in pieces of eight with no branch
+//! as nine ranges of three cells (more where the row wraps around) of the sorted
+//! structure-of-arrays positions, looked up once per cell (the sorted particles of a cell are
+//! consecutive). Each range is tested where it lies, four candidates at a time for
+//! `r² < R²` (no square root; one packed compare on x86-64), in pieces of eight with no branch
 //! on the range's length, and the hits of many pieces are taken from one mask, a byte a piece
-//! ([`test_ranges`]). Two consecutive particles of one cell share that pass: each piece is
-//! loaded once and tested for both. What costs here is cache misses and mispredicted branches
-//! more than instructions: valgrind's branch simulation (the whole pass, 7 SPH steps of
-//! Mannequin A, `--toggle-collect='*NeighbourLists*build*'`) counts 11.7 M mispredictions and
-//! 4.50 G instructions in the earlier pass, 8.5 M and 3.87 G now (the kept density term
-//! without a branch took 2.4 M of the mispredictions; the byte masks and the pairs took the
-//! instructions, and no time that could be measured), and the raster grid ([`super::grid`])
-//! took about 40 % off the pass's time by keeping the rows it reads in cache. The first `cap`
-//! hits (that are not the particle itself nor its own strand's near nodes) are kept, in scan
-//! order. The order is a function of the positions only, so lists, truncation and every sum
-//! over a list are the same on any number of threads.
+//! ([`test_ranges`]). A particle itself and its own strand's near nodes are never candidates.
 //!
 //! Lists are stored compactly: a chunk of particles writes its lists one after another into
-//! its own part of the storage, so the few neighbours a particle has (about five on a head)
-//! take a few bytes, not a cache line and a half of room for `cap` of them.
+//! its own vector, which keeps its capacity from one rebuild to the next.
 
 #![deny(clippy::too_many_lines, clippy::too_many_arguments)]
 use hairsim_core::Vec3;
 use rayon::prelude::*;
 
-use super::forces::{poly6_factor, SortedParticles};
 use super::grid::{cell_of, Grid, Layout, RowsAround, MAX_RANGES};
-use super::{SphParams, CHUNK, MAX_CAP};
+use super::CHUNK;
 
 /// Entries past the last particle in the position arrays: a range is tested in pieces of
 /// [`SHORT`] candidates whatever its length (at least that many).
@@ -43,382 +33,183 @@ const LANES: usize = 4;
 /// Bits of a particle's key holding its node index; the strand is above them.
 pub const NODE_BITS: u32 = 8;
 
-/// One list of at most `cap` neighbours per particle, in sorted indices.
-#[derive(Clone, Debug)]
-pub struct NeighbourLists {
-    cap: usize,
-    /// Every list: chunk `c`'s lists one after another from `c · (CHUNK · cap + 1)`.
-    pub list: Vec<u32>,
-    /// Where each particle's list starts in `list`.
-    pub start: Vec<u32>,
-    /// How many neighbours each particle kept.
-    pub count: Vec<u32>,
+/// Candidates a particle has room for when the lists are first sized: a step allocates only
+/// when a chunk of particles has more candidates than ever before and more than this many a
+/// particle.
+pub const ROOM: usize = 8;
+
+/// The particles in the grid's sorted order, as the search reads them: positions in the
+/// skin's frame as structure of arrays (with [`PADDING`] entries past the last, never a
+/// candidate) and keys.
+#[derive(Clone, Debug, Default)]
+pub struct Sorted {
+    /// Positions, m: x.
+    pub x: Vec<f32>,
+    /// Positions, m: y.
+    pub y: Vec<f32>,
+    /// Positions, m: z.
+    pub z: Vec<f32>,
+    /// Keys: `strand << NODE_BITS | node`.
+    pub key: Vec<u32>,
 }
 
-/// Counts from one build.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Found {
-    /// Neighbours kept, summed over particles.
-    pub kept: u64,
-    /// Neighbours dropped by the cap.
-    pub truncated: u64,
-    /// Most neighbours one particle had before the cap.
-    pub max_found: u32,
-}
-
-impl Found {
-    fn merge(self, other: Found) -> Found {
-        Found {
-            kept: self.kept + other.kept,
-            truncated: self.truncated + other.truncated,
-            max_found: self.max_found.max(other.max_found),
+impl Sorted {
+    /// Buffers for `n` particles.
+    #[must_use]
+    pub fn new(n: usize) -> Sorted {
+        Sorted {
+            x: vec![0.0; n + PADDING],
+            y: vec![0.0; n + PADDING],
+            z: vec![0.0; n + PADDING],
+            key: vec![0; n],
         }
+    }
+
+    /// Fills the sorted arrays: sorted particle `k` is particle `order[k]`, at `frame[p]`,
+    /// with key `key[p]` (Algorithm 1 line 5), chunk by chunk in parallel.
+    pub fn gather(&mut self, order: &[u32], frame: &[[f32; 3]], key: &[u32]) {
+        let n = order.len().min(self.key.len());
+        (
+            self.x[..n].par_chunks_mut(CHUNK),
+            self.y[..n].par_chunks_mut(CHUNK),
+            self.z[..n].par_chunks_mut(CHUNK),
+            self.key[..n].par_chunks_mut(CHUNK),
+        )
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(c, (x, y, z, k))| {
+                for (i, &p) in order[c * CHUNK..].iter().take(x.len()).enumerate() {
+                    let (Some(position), Some(&own)) = (frame.get(p as usize), key.get(p as usize))
+                    else {
+                        continue;
+                    };
+                    [x[i], y[i], z[i]] = *position;
+                    k[i] = own;
+                }
+            });
     }
 }
 
-impl NeighbourLists {
-    /// Lists for `particles` particles of at most `cap` neighbours each.
+/// Every sorted particle's candidate list, in sorted indices.
+#[derive(Clone, Debug, Default)]
+pub struct CandidateLists {
+    /// Chunk `c`'s lists (sorted particles `c · CHUNK ..`), one after another.
+    pub lists: Vec<Vec<u32>>,
+    /// Where each sorted particle's list starts in its chunk's vector.
+    pub start: Vec<u32>,
+    /// How many candidates each sorted particle has.
+    pub count: Vec<u32>,
+}
+
+impl CandidateLists {
+    /// Lists for `particles` particles, with room for [`ROOM`] candidates a particle.
     #[must_use]
-    pub fn new(particles: usize, cap: usize) -> NeighbourLists {
-        NeighbourLists {
-            cap,
-            list: vec![0; particles.div_ceil(CHUNK) * (CHUNK * cap + 1)],
+    pub fn new(particles: usize) -> CandidateLists {
+        CandidateLists {
+            lists: (0..particles.div_ceil(CHUNK))
+                .map(|_| Vec::with_capacity(CHUNK * ROOM))
+                .collect(),
             start: vec![0; particles],
             count: vec![0; particles],
         }
     }
 
-    /// The neighbours of sorted particle `a`.
+    /// The candidates of sorted particle `k`.
     #[inline]
     #[must_use]
-    pub fn of(&self, a: usize) -> &[u32] {
-        let start = self.start[a] as usize;
-        &self.list[start..start + self.count[a] as usize]
+    pub fn of(&self, k: usize) -> &[u32] {
+        let (start, count) = (self.start[k] as usize, self.count[k] as usize);
+        self.lists
+            .get(k / CHUNK)
+            .and_then(|l| l.get(start..start + count))
+            .unwrap_or(&[])
     }
 
-    /// Rebuilds every list from the sorted particles, and writes each particle's density
-    /// (`p.density`) and its packed force inputs (`p.packed`, with the pressure).
-    pub fn build(&mut self, grid: &Grid, p: &mut SortedParticles, params: &SphParams) -> Found {
-        let cap = self.cap;
-        let n = p.mass.len();
-        let SortedParticles {
-            x,
-            y,
-            z,
-            velocity,
-            mass,
-            key,
-            density,
-            packed,
-            ..
-        } = p;
-        let h = params.smoothing_length;
-        let h2 = h * h;
+    /// Rebuilds every list from the sorted particles `p` in `grid`: the particles within
+    /// `reach` of each, but itself and its own strand's nodes at most `gap` apart. Returns how
+    /// many candidates there are in all.
+    pub fn build(&mut self, grid: &Grid, p: &Sorted, reach: f32, gap: u32) -> u64 {
+        let n = p.key.len();
         let search = Search {
-            x,
-            y,
-            z,
-            velocity,
-            near: Near {
-                key,
-                mass,
-                cap,
-                gap: params.same_strand_gap,
-                h2,
-            },
+            xyz: (&p.x, &p.y, &p.z),
+            key: &p.key,
+            gap,
+            reach_squared: reach * reach,
             grid,
             inverse_cell: grid.inverse_cell(),
             layout: grid.layout(),
-            c6: poly6_factor(h),
-            stiffness: params.stiffness,
-            rest: params.rest_density,
         };
-        self.list
-            .par_chunks_mut(CHUNK * cap + 1)
+        self.lists
+            .par_iter_mut()
             .zip(self.start[..n].par_chunks_mut(CHUNK))
             .zip(self.count[..n].par_chunks_mut(CHUNK))
-            .zip(density.par_chunks_mut(CHUNK))
-            .zip(packed.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(c, ((((list, start), count), density), packed))| {
-                let mut chunk = Chunk {
-                    c,
-                    list,
-                    start,
-                    count,
-                    density,
-                    packed,
-                    found: Found::default(),
-                };
-                search.chunk(&mut chunk);
-                chunk.found
+            .map(|(c, ((list, start), count))| {
+                search.chunk(c, list, start, count);
+                list.len() as u64
             })
-            .reduce(Found::default, Found::merge)
+            .sum()
     }
 }
 
 /// What every chunk's search reads: the sorted particles, the grid, and the parameters as
 /// the search uses them.
 struct Search<'a> {
-    x: &'a [f32],
-    y: &'a [f32],
-    z: &'a [f32],
-    velocity: &'a [[f32; 3]],
-    /// The sorted keys and masses, the cap, the same-strand gap and `h²`.
-    near: Near<'a>,
+    xyz: (&'a [f32], &'a [f32], &'a [f32]),
+    key: &'a [u32],
+    gap: u32,
+    reach_squared: f32,
     grid: &'a Grid,
     inverse_cell: f32,
     layout: Layout,
-    /// The poly6 kernel's factor.
-    c6: f32,
-    stiffness: f32,
-    /// Rest density.
-    rest: f32,
-}
-
-/// One chunk of particles: what its search writes, and its counts.
-struct Chunk<'a> {
-    /// The chunk's index.
-    c: usize,
-    /// The chunk's part of the list storage.
-    list: &'a mut [u32],
-    start: &'a mut [u32],
-    count: &'a mut [u32],
-    density: &'a mut [f32],
-    packed: &'a mut [[f32; 8]],
-    found: Found,
-}
-
-/// A particle of a chunk (sorted `a`, at `me`) and, when the next one is in the same cell,
-/// that one's position: the two take their lists in one pass.
-struct Particles {
-    a: usize,
-    me: [f32; 3],
-    pair: Option<[f32; 3]>,
-}
-
-/// The 27 cells around the particles' cell, as ranges of sorted particles: the rows around
-/// it follow every particle; the ranges are looked up again only when the cell changes.
-struct CellRanges {
-    rows: RowsAround,
-    ranges: [(u32, u32); MAX_RANGES],
-    /// The cell whose 27 cells `ranges` holds, and how many ranges: sorted particles of one
-    /// cell are consecutive and share them.
-    ranged: Option<([i32; 3], usize)>,
-}
-
-impl CellRanges {
-    /// The ranges around `cell`.
-    #[inline(always)]
-    fn around(&mut self, grid: &Grid, cell: [i32; 3], layout: Layout) -> &[(u32, u32)] {
-        self.rows.update(cell, layout);
-        let m = match self.ranged {
-            Some((of, m)) if of == cell => m,
-            _ => {
-                let m = self.rows.ranges(grid, cell, &mut self.ranges);
-                self.ranged = Some((cell, m));
-                m
-            }
-        };
-        &self.ranges[..m]
-    }
 }
 
 impl Search<'_> {
     /// Sorted particle `a`'s position.
     #[inline(always)]
     fn at(&self, a: usize) -> [f32; 3] {
-        [self.x[a], self.y[a], self.z[a]]
+        [self.xyz.0[a], self.xyz.1[a], self.xyz.2[a]]
     }
 
-    /// Sorted particle `a`'s cell.
-    #[inline(always)]
-    fn cell_at(&self, a: usize) -> [i32; 3] {
-        cell_of(
-            Vec3::new(self.x[a], self.y[a], self.z[a]),
-            self.inverse_cell,
-        )
-    }
-
-    /// Every list of chunk `chunk.c`, one particle after another, or two at once when the
-    /// next particle is in the same cell.
-    #[inline(always)]
-    fn chunk(&self, chunk: &mut Chunk<'_>) {
-        let cap = self.near.cap;
-        let mut cells = CellRanges {
-            rows: RowsAround::NONE,
-            ranges: [(0u32, 0u32); MAX_RANGES],
-            ranged: None,
-        };
-        let mut used = 0usize;
-        // The second particle of a pair gathers its list here; it is moved next to the first
-        // one's once that one's length is known.
-        let mut spare = [0u32; MAX_CAP + 1];
-        let record_len = chunk.count.len();
-        // Particle `k`'s cell when the previous pass looked it up already.
-        let mut known = None;
-        let mut k = 0;
-        // Bounded: `k` moves on by one or two a pass.
-        while k < record_len {
-            let a = chunk.c * CHUNK + k;
+    /// Every list of chunk `c`, one particle after another.
+    fn chunk(&self, c: usize, list: &mut Vec<u32>, start: &mut [u32], count: &mut [u32]) {
+        list.clear();
+        let mut rows = RowsAround::NONE;
+        let mut ranges = [(0u32, 0u32); MAX_RANGES];
+        // The cell whose 27 cells `ranges` holds, and how many: sorted particles of one cell
+        // are consecutive and share them.
+        let mut ranged: Option<([i32; 3], usize)> = None;
+        for (k, (start, count)) in start.iter_mut().zip(count.iter_mut()).enumerate() {
+            let a = c * CHUNK + k;
             let me = self.at(a);
-            let cell = known.unwrap_or_else(|| self.cell_at(a));
-            let ranges = cells.around(self.grid, cell, self.layout);
-            // The next particle, if it is in the same cell: the two share one pass over
-            // their ranges (the loads, the range and piece bookkeeping).
-            let b = a + 1;
-            let next = (k + 1 < record_len).then(|| self.cell_at(b));
-            let pair = (next == Some(cell)).then(|| self.at(b));
-            known = if pair.is_some() { None } else { next };
-            let mine = &mut chunk.list[used..used + cap + 1];
-            let particles = Particles { a, me, pair };
-            let (one, two) = self.gather(ranges, &particles, used, mine, &mut spare[..cap + 1]);
-            self.record(chunk, k, a, me, &one);
-            used += one.kept;
-            if let (Some(mut two), Some(other)) = (two, pair) {
-                chunk.list[used..used + two.kept].copy_from_slice(&spare[..two.kept]);
-                two.at = used;
-                self.record(chunk, k + 1, b, other, &two);
-                used += two.kept;
-            }
-            k += 1 + usize::from(pair.is_some());
-        }
-    }
-
-    /// The lists of particle `p.a` (into `mine`, which starts at `used` in the chunk's
-    /// storage) and, with `p.pair`, of particle `p.a + 1` (into `theirs`), in one pass over
-    /// `ranges`.
-    #[inline(always)]
-    fn gather(
-        &self,
-        ranges: &[(u32, u32)],
-        p: &Particles,
-        used: usize,
-        mine: &mut [u32],
-        theirs: &mut [u32],
-    ) -> (Gathered, Option<Gathered>) {
-        let (key, mass, h2) = (self.near.key, self.near.mass, self.near.h2);
-        let (a, me, near) = (p.a, p.me, &self.near);
-        let xyz = (self.x, self.y, self.z);
-        let mut one = Gather::new(a, key[a], mass[a] * h2 * h2 * h2, used);
-        match p.pair {
-            Some(other) => {
-                let b = a + 1;
-                let mut two = Gather::new(b, key[b], mass[b] * h2 * h2 * h2, 0);
-                test_ranges(ranges, xyz, ([a, b], [me, other]), h2, &mut |p, j, d2| {
-                    if p == 0 {
-                        one.hit(j, d2, near, mine);
-                    } else {
-                        two.hit(j, d2, near, theirs);
+            let cell = cell_of(Vec3::from_array(me), self.inverse_cell);
+            rows.update(cell, self.layout);
+            let m = match ranged {
+                Some((of, m)) if of == cell => m,
+                _ => {
+                    let m = rows.ranges(self.grid, cell, &mut ranges);
+                    ranged = Some((cell, m));
+                    m
+                }
+            };
+            let first = list.len();
+            let own = self.key.get(a).copied().unwrap_or(0);
+            let (key, gap) = (self.key, self.gap);
+            test_ranges(
+                &ranges[..m],
+                self.xyz,
+                a,
+                me,
+                self.reach_squared,
+                &mut |j| {
+                    let other = key.get(j).copied().unwrap_or(own);
+                    if !near_on_strand(other, own, gap) {
+                        list.push(j as u32);
                     }
-                });
-                (one.done(), Some(two.done()))
-            }
-            None => {
-                test_ranges(ranges, xyz, ([a], [me]), h2, &mut |_, j, d2| {
-                    one.hit(j, d2, near, mine);
-                });
-                (one.done(), None)
-            }
-        }
-    }
-
-    /// Writes particle `k` of the chunk (sorted `a`, at `me`): where its list starts, its
-    /// count, its density, and its force inputs with the pressure.
-    #[inline(always)]
-    fn record(&self, chunk: &mut Chunk<'_>, k: usize, a: usize, me: [f32; 3], list: &Gathered) {
-        let cap = self.near.cap;
-        let found = &mut chunk.found;
-        chunk.start[k] = (chunk.c * (CHUNK * cap + 1) + list.at) as u32;
-        chunk.count[k] = list.kept as u32;
-        found.kept += list.kept as u64;
-        found.truncated += u64::from(list.all) - list.kept as u64;
-        found.max_found = found.max_found.max(list.all);
-        let rho = self.c6 * list.sum;
-        let pr = (self.stiffness * (rho - self.rest)).max(0.0);
-        chunk.density[k] = rho;
-        let [vx, vy, vz] = self.velocity[a];
-        chunk.packed[k] = [me[0], me[1], me[2], self.near.mass[a] / rho, vx, vy, vz, pr];
-    }
-}
-
-/// What a particle's hits are checked against: the sorted keys and masses, the cap, the
-/// same-strand gap and `h²`.
-struct Near<'a> {
-    key: &'a [u32],
-    mass: &'a [f32],
-    cap: usize,
-    gap: u32,
-    h2: f32,
-}
-
-/// One particle's list being gathered.
-struct Gather {
-    /// The particle (sorted index).
-    a: usize,
-    /// Its key.
-    key: u32,
-    /// Where its list starts in the chunk's storage.
-    at: usize,
-    kept: usize,
-    all: u32,
-    /// `ρ / (315/(64π h⁹))`: own mass, then the kept neighbours in list order.
-    sum: f32,
-}
-
-/// A gathered list: where it starts, how many were kept and found, and the density sum.
-struct Gathered {
-    at: usize,
-    kept: usize,
-    all: u32,
-    sum: f32,
-}
-
-impl Gather {
-    #[inline(always)]
-    fn new(a: usize, key: u32, own: f32, at: usize) -> Gather {
-        Gather {
-            a,
-            key,
-            at,
-            kept: 0,
-            all: 0,
-            sum: own,
-        }
-    }
-
-    /// Takes sorted particle `j` at `r² = d2` (within `h`): a neighbour unless it is the
-    /// particle itself or a near node of its own strand, kept while there is room under the
-    /// cap. It is written to `list` whether it is kept or not, and counted only if it is (no
-    /// branch on it: `list` has one entry of room past the cap).
-    #[inline(always)]
-    fn hit(&mut self, j: usize, d2: f32, near: &Near<'_>, list: &mut [u32]) {
-        let (Some(&other), Some(&m)) = (near.key.get(j), near.mass.get(j)) else {
-            return;
-        };
-        let neighbour = (j != self.a) & !near_on_strand(other, self.key, near.gap);
-        let keep = neighbour & (self.kept < near.cap);
-        if let Some(slot) = list.get_mut(self.kept.min(near.cap)) {
-            *slot = j as u32;
-        }
-        let w = near.h2 - d2;
-        // `m · 1` is `m` and `m · 0` is +0 (masses are positive), and adding +0 leaves the
-        // sum's bits as they are: the kept term without a branch, which LLVM makes of an
-        // `if` here and which mispredicts (a particle's own and same-strand hits come at
-        // random places in its list).
-        let m = m * f32::from(u8::from(keep));
-        self.sum += m * (w * w * w);
-        self.kept += usize::from(keep);
-        self.all += u32::from(neighbour);
-    }
-
-    #[inline(always)]
-    fn done(self) -> Gathered {
-        Gathered {
-            at: self.at,
-            kept: self.kept,
-            all: self.all,
-            sum: self.sum,
+                },
+            );
+            *start = first as u32;
+            *count = (list.len() - first) as u32;
         }
     }
 }
@@ -452,24 +243,23 @@ const TAIL: [u8; SHORT + 1] = {
     tail
 };
 
-/// Calls `hit(p, j, r²)` for every sorted particle `j` of `ranges` with `r² < h2` from
-/// particle `p`'s position `me[p]`, in order for each `p` (range by range, each in sorted
-/// order), testing them where they lie. `P` particles of one cell share the pass: each piece
-/// is loaded once and tested for each of them. A range is tested in pieces of [`SHORT`] (most
-/// ranges are one piece: a range holds about five particles on a head), each as two blocks of
-/// [`LANES`] with the lanes past the range's end masked off — the position arrays have
-/// [`PADDING`] entries past the last particle — and the hits of up to [`GROUP`] pieces go into
-/// one mask, a byte a piece, so that neither a range's length nor its hits cost a branch of
-/// their own; the few hits are then taken from the mask in one loop.
+/// Calls `hit(j)` for every sorted particle `j` of `ranges` but `own` with `r² < reach²`
+/// (`reach_squared`) from `me`, in order (range by range, each in sorted order), testing them
+/// where they lie. A range is tested in pieces of [`SHORT`] (most ranges are one or two
+/// pieces), each as two blocks of [`LANES`] with the lanes past the range's end masked off —
+/// the position arrays have [`PADDING`] entries past the last particle — and the hits of up to
+/// [`GROUP`] pieces go into one mask, a byte a piece, so that neither a range's length nor its
+/// hits cost a branch of their own; the hits are then taken from the mask in one loop.
 #[inline(always)]
-fn test_ranges<const P: usize>(
+fn test_ranges(
     ranges: &[(u32, u32)],
     xyz: (&[f32], &[f32], &[f32]),
-    (own, me): ([usize; P], [[f32; 3]; P]),
-    h2: f32,
-    hit: &mut impl FnMut(usize, usize, f32),
+    own: usize,
+    me: [f32; 3],
+    reach_squared: f32,
+    hit: &mut impl FnMut(usize),
 ) {
-    let mut hits = [[0u8; GROUP]; P];
+    let mut hits = [0u8; GROUP];
     let mut starts = [0u32; GROUP];
     let mut held = 0;
     for (r, &(s, e)) in ranges.iter().enumerate() {
@@ -478,18 +268,15 @@ fn test_ranges<const P: usize>(
         // Bounded: `s` moves on by SHORT a pass until it reaches `e`.
         loop {
             if held == GROUP {
-                take_held(&mut hits, &starts, xyz, me, hit);
+                take_hits(u128::from_le_bytes(hits), &starts, hit);
+                hits = [0; GROUP];
                 held = 0;
             }
             let tail = TAIL[((e - s) as usize).min(SHORT)];
-            let bits = piece(xyz, s as usize, me, h2);
-            for ((hits, bits), &own) in hits.iter_mut().zip(bits).zip(&own) {
-                // The particle itself lies in the first range (its own row): a hit that is
-                // never a neighbour, dropped here rather than taken and thrown away.
-                let itself = if r == 0 { not_at(own, s) } else { u8::MAX };
-                hits[held % GROUP] = bits & tail & itself;
-            }
-            starts[held % GROUP] = s;
+            // The particle itself lies in the first range (its own row): dropped here.
+            let itself = if r == 0 { not_at(own, s) } else { u8::MAX };
+            hits[held] = piece(xyz, s as usize, me, reach_squared) & tail & itself;
+            starts[held] = s;
             held += 1;
             s += SHORT as u32;
             if s >= e {
@@ -497,24 +284,7 @@ fn test_ranges<const P: usize>(
             }
         }
     }
-    take_held(&mut hits, &starts, xyz, me, hit);
-}
-
-/// Takes the hits held for each particle `p` (calling `hit(p, j, r²)`), and clears them.
-#[inline(always)]
-fn take_held<const P: usize>(
-    hits: &mut [[u8; GROUP]; P],
-    starts: &[u32; GROUP],
-    xyz: (&[f32], &[f32], &[f32]),
-    me: [[f32; 3]; P],
-    hit: &mut impl FnMut(usize, usize, f32),
-) {
-    for (p, (hits, me)) in hits.iter_mut().zip(me).enumerate() {
-        take_hits(u128::from_le_bytes(*hits), starts, xyz, me, &mut |j, d2| {
-            hit(p, j, d2)
-        });
-        *hits = [0; GROUP];
-    }
+    take_hits(u128::from_le_bytes(hits), &starts, hit);
 }
 
 /// All bits of a piece starting at `s` but particle `own`'s.
@@ -528,49 +298,31 @@ fn not_at(own: usize, s: u32) -> u8 {
     }
 }
 
-/// A bit per candidate `s .. s + SHORT` with `r² < h2` from each of `me` (all of them read:
+/// A bit per candidate `s .. s + SHORT` with `r² < reach_squared` from `me` (all of them read:
 /// the arrays are padded), as two blocks of [`LANES`].
 #[inline(always)]
-fn piece<const P: usize>(
-    (x, y, z): (&[f32], &[f32], &[f32]),
-    s: usize,
-    me: [[f32; 3]; P],
-    h2: f32,
-) -> [u8; P] {
+fn piece((x, y, z): (&[f32], &[f32], &[f32]), s: usize, me: [f32; 3], reach_squared: f32) -> u8 {
     let (Some(bx), Some(by), Some(bz)) = (block(x, s), block(y, s), block(z, s)) else {
-        return [0; P];
+        return 0;
     };
     let ((Some(x0), Some(x1)), (Some(y0), Some(y1)), (Some(z0), Some(z1))) =
         (halves(bx), halves(by), halves(bz))
     else {
-        return [0; P];
+        return 0;
     };
-    let (low, high) = ((x0, y0, z0), (x1, y1, z1));
-    me.map(|me| {
-        let low = within(low.0, low.1, low.2, me, h2);
-        let high = within(high.0, high.1, high.2, me, h2);
-        (low | high << LANES) as u8
-    })
+    let low = within(x0, y0, z0, me, reach_squared);
+    let high = within(x1, y1, z1, me, reach_squared);
+    (low | high << LANES) as u8
 }
 
 /// Calls `hit` for each set bit of `mask` (bit `SHORT · g + l`: particle `starts[g] + l`), in
 /// bit order.
 #[inline(always)]
-fn take_hits(
-    mut mask: u128,
-    starts: &[u32; GROUP],
-    (x, y, z): (&[f32], &[f32], &[f32]),
-    me: [f32; 3],
-    hit: &mut impl FnMut(usize, f32),
-) {
+fn take_hits(mut mask: u128, starts: &[u32; GROUP], hit: &mut impl FnMut(usize)) {
     while mask != 0 {
         let bit = mask.trailing_zeros() as usize;
         mask &= mask - 1;
-        let j = starts[bit / SHORT] as usize + bit % SHORT;
-        let (Some(&xj), Some(&yj), Some(&zj)) = (x.get(j), y.get(j), z.get(j)) else {
-            continue;
-        };
-        hit(j, distance_squared(me, [xj, yj, zj]));
+        hit(starts[bit / SHORT] as usize + bit % SHORT);
     }
 }
 
