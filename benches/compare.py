@@ -13,8 +13,10 @@ medians over the rounds, the median of the per-round ratios new/old, and every r
 the spread of those is the noise to read a ratio against (run a checkout against itself to
 see it). A ratio above `--limit` (1.03 by default) in the median is marked.
 
-Only benches with criterion rows are compared (the custom ones — `bandwidth`, `dftl_cpu`,
-`latency`, `sph` — print their own tables; `benches/performance.py` runs those). Wall-clock
+The criterion benches are compared row by row, and so are two custom ones: `dftl_cpu` (each
+row's wall-clock time per million vertex-steps; `--filter` is then its label filter, words
+separated by spaces, e.g. `--bench dftl_cpu --filter "block-8 block-16"`) and `sph` (each
+configuration's milliseconds per step; `--filter "mannequin-b dftl+shape 2t"`). Wall-clock
 ratios on a shared machine move by several per cent between rounds; where a ratio matters,
 count instructions as well (for example with callgrind) and say which.
 
@@ -33,6 +35,17 @@ from performance import bench_executables, cpu_info, log
 
 ROOT = Path(__file__).resolve().parent.parent
 CRITERION_BENCHES = ["dftl", "effects", "rod_projection", "rod_twist", "step"]
+# Custom benches: each line the parser reads is a row, its value a time (lower is faster).
+DFTL_CPU_ROW = re.compile(r"^(\d+ x \d+ \S.*?)\s+[\d.]+ M/CPU-s\s+([\d.]+) M/wall-s", re.M)
+SPH_ROW = re.compile(r"^(\S+)\s+\d+ vertices (\S+)\s+(\d) thread\(s\):.*?([\d.]+) ms/step", re.M)
+CUSTOM_BENCHES = {
+    # Seconds per million vertex-steps.
+    "dftl_cpu": lambda out: {m.group(1).strip(): 1.0 / float(m.group(2))
+                             for m in DFTL_CPU_ROW.finditer(out) if float(m.group(2)) > 0},
+    # Seconds per step.
+    "sph": lambda out: {f"{m.group(1)} {m.group(2)} {m.group(3)}t": float(m.group(4)) * 1e-3
+                        for m in SPH_ROW.finditer(out)},
+}
 UNIT = {"ps": 1e-12, "ns": 1e-9, "µs": 1e-6, "us": 1e-6, "ms": 1e-3, "s": 1.0}
 
 
@@ -52,8 +65,14 @@ def build(checkout, benches):
     return found
 
 
-def medians(executable, pattern, criterion_args):
-    """Criterion's median time (s) of every row of `executable` matching `pattern`."""
+def medians(executable, pattern, criterion_args, bench=None):
+    """Criterion's median time (s) of every row of `executable` matching `pattern`; for a custom
+    bench, its rows' times."""
+    if bench in CUSTOM_BENCHES:
+        # `cargo bench` runs a bench in its package's folder.
+        output = subprocess.run([executable, "--bench", *pattern.split()], capture_output=True,
+                                text=True, cwd=Path(__file__).resolve().parent).stdout
+        return CUSTOM_BENCHES[bench](output)
     output = subprocess.run(
         [executable, "--bench", "--noplot", pattern, *criterion_args],
         capture_output=True, text=True,
@@ -89,7 +108,7 @@ def compare(old, new, bench, args):
         order = [("old", old), ("new", new)] if r % 2 == 0 else [("new", new), ("old", old)]
         for label, executable in order:
             log(f"{bench}: round {r + 1} of {args.rounds}, {label}")
-            for row, t in medians(executable, args.filter, criterion_args).items():
+            for row, t in medians(executable, args.filter, criterion_args, bench).items():
                 times.setdefault(row, {"old": [], "new": []})[label].append(t)
     return times
 
@@ -132,13 +151,28 @@ firmware scene step     time:   [41.032 µs 41.104 µs 41.180 µs]
 """
 
 
+CUSTOM_SAMPLES = {
+    "dftl_cpu": ("1024 x 8 block-16 2 threads dftl+shape         92.3 M/CPU-s    180.5 M/wall-s\n"
+                 "state hash (64 x 32, 200 steps, shape): per-strand 0x1\n",
+                 {"1024 x 8 block-16 2 threads dftl+shape": 1 / 180.5}),
+    "sph": ("mannequin-b      8000 vertices dftl+shape       2 thread(s):   66.70 M vertex-steps/s "
+            "wall,   40.00 M/CPU-s,    0.120 ms/step, dt 0.0167 s\n",
+            {"mannequin-b dftl+shape 2t": 0.120e-3}),
+}
+
+
 def self_test():
-    """The parser against a sample of criterion's output."""
+    """The parsers against samples of criterion's and the custom benches' output."""
     rows = parse_criterion(SAMPLE)
     expected = {"dftl 1024 x 8/per-strand/dftl": 128.62e-6, "firmware scene step": 41.104e-6}
     assert rows.keys() == expected.keys(), rows
     for row, t in expected.items():
         assert abs(rows[row] - t) < 1e-12, (row, rows[row])
+    for bench, (sample, want) in CUSTOM_SAMPLES.items():
+        got = CUSTOM_BENCHES[bench](sample)
+        assert got.keys() == want.keys(), (bench, got)
+        for row, t in want.items():
+            assert abs(got[row] - t) < 1e-12, (bench, row, got[row])
     print("compare.py: parser self-test passed")
 
 
@@ -160,10 +194,11 @@ def main():
                         help="a median ratio above this is marked slower (1.03)")
     args = parser.parse_args()
     benches = [b for b in args.bench.split(",") if b]
-    unknown = [b for b in benches if b not in CRITERION_BENCHES]
+    known = CRITERION_BENCHES + list(CUSTOM_BENCHES)
+    unknown = [b for b in benches if b not in known]
     if unknown:
-        sys.exit(f"not a criterion bench: {', '.join(unknown)} "
-                 f"(choose from {', '.join(CRITERION_BENCHES)})")
+        sys.exit(f"not a bench compare.py reads: {', '.join(unknown)} "
+                 f"(choose from {', '.join(known)})")
     info = cpu_info()
     cpu = f"{info['model']} (family {info['family']}, model {info['model_number']})"
     old = build(args.old.resolve(), benches)

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Measures hairsim beside the papers' tables and prints docs/performance.md.
 
-    python3 benches/performance.py > docs/performance.md     # the full run
-    python3 benches/performance.py --quick                   # a short trial run
+    python3 benches/performance.py --record docs/performance.json > docs/performance.md
+    python3 benches/performance.py --replay docs/performance.json    # the same page, no bench
+    python3 benches/performance.py --quick                            # a short trial run
 
 Prints the machine (CPU model, cores, AVX-512, rustc, date, load average at start and end),
 the memory bandwidth measured in the same run, then each paper table with the paper's figures
@@ -14,6 +15,34 @@ are installed, and says so when they are not; so does the C example's table (fla
 stack of `firmware-c/`, as `bash .ci/ffi` measures them), which also needs arm-none-eabi-gcc
 and newlib.
 
+docs/performance.md is this script's output, whole: nothing is written into it by hand. With
+`--record FILE` the script also writes what it measured (each command's output and each value
+read from the machine, in order) to FILE; `--replay FILE` prints the page again from FILE
+without running anything. Kept beside the page as docs/performance.json, the recording lets a
+check compare the page with its replay (a hand edit, or a change to this script's text that
+was not replayed into the page, shows as a difference) and lets a change to the text be
+carried into the page without measuring again (`--replay docs/performance.json >
+docs/performance.md`).
+
+Tables measured by other scripts: each `benches/tables/NAME.json` (files taken in name order)
+becomes a section of its own, placed after the section its `"after"` names (one of the names
+of `--only` below; at the end otherwise). The file is one JSON object:
+    {"title": "Strands each solver keeps in real time in the browser",
+     "after": "latency",
+     "text": "What the table shows, one paragraph.",
+     "command": "python3 .ci/viewer-test.py --sweep target/release/hairsim",
+     "date": "2026-12-07 10:00 UTC",
+     "header": ["solver", "strands × nodes", "real-time ratio"],
+     "align": "llr",
+     "rows": [["rod", "25 × 30", "1.00"], ["DFTL", "400 × 30", "1.00"]]}
+("text", "command", "date" and "align" may be left out; a cell is a string.) The script that
+measures the table writes the file; the page is then replayed (or measured again).
+
+A section measured by a bench of its own: write `NAME_section(runner)`, which runs the bench
+through `runner.custom(BENCH, [arguments])` (or `runner.criterion`) and returns Markdown, then
+add NAME to SECTIONS (its place on the page), to BENCH (the bench it builds) and to `single` in
+`measure`.
+
 Progress goes to stderr; the Markdown is printed to stdout at the end. Python 3 standard
 library only. Options:
   --quick     short criterion times, one run of each custom bench: for trying it out;
@@ -23,7 +52,9 @@ library only. Options:
   --runs N    runs of `dftl_cpu` and `sph` (medians; 3, or 1 with --quick);
   --no-build  run the bench binaries already built, without cargo;
   --only a,b  some sections only: bandwidth, step, twist, projection, dftl, sph, effects,
-              latency, firmware, c (the C example's flash, RAM and stack).
+              latency, firmware, c (the C example's flash, RAM and stack);
+  --record F  also write what was measured to F;
+  --replay F  print the page from F, measuring nothing.
 """
 
 import argparse
@@ -43,6 +74,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 SECTIONS = ["bandwidth", "step", "twist", "projection", "dftl", "sph", "effects", "latency",
             "firmware", "c"]
+# Tables measured by other scripts (see the docstring).
+TABLES = "benches/tables"
+# The SPH bench's second run: the scenes at 1 ms, two threads, with and without hair–hair.
+SPH_MILLISECOND = ["dt=0.001", "2t", "dftl+shape", "dftl+shape+hair-hair"]
 # The bench binary each section runs.
 BENCH = {"bandwidth": "bandwidth", "step": "step", "twist": "rod_twist",
          "projection": "rod_projection", "dftl": "dftl_cpu", "sph": "sph", "effects": "effects",
@@ -60,7 +95,54 @@ def log(message):
     print(f"[{time.time() - START:6.0f} s] {message}", file=sys.stderr, flush=True)
 
 
+class Tape:
+    """What a run measured, in the order it measured it: every command's output, every value
+    read from the machine (CPU, load, clock). `--record FILE` writes it; `--replay FILE` prints
+    the document again from it without running anything, as CI does to check that
+    docs/performance.md is this script's output, whole."""
+
+    def __init__(self):
+        self.mode, self.entries, self.position = None, [], 0
+
+    def take(self, kind, key, compute):
+        """`compute()`, recorded under (`kind`, `key`); when replaying, what was recorded."""
+        if self.mode == "replay":
+            if self.position >= len(self.entries):
+                sys.exit(f"the recording ends before {kind} {key}: record it again")
+            entry = self.entries[self.position]
+            self.position += 1
+            if entry[:2] != [kind, key]:
+                sys.exit(f"entry {self.position - 1} of the recording is {entry[:2]}, not "
+                         f"{[kind, key]}: the script measures something else now; record again")
+            return entry[2]
+        value = compute()
+        if self.mode == "record":
+            self.entries.append([kind, key, value])
+        return value
+
+
+TAPE = Tape()
+
+
 def run(cmd, env=None, cwd=ROOT, timeout=None, quiet=False):
+    """Runs `cmd`; returns (return code, stdout, stderr). Recorded by the tape under the
+    program's name (paths differ from one checkout to another)."""
+    program = Path(cmd[1] if Path(cmd[0]).name.startswith("python") else cmd[0]).name
+    return TAPE.take("run", program, lambda: run_now(cmd, env, cwd, timeout, quiet))
+
+
+def which(tool):
+    """`shutil.which(tool)`, recorded."""
+    return TAPE.take("which", tool, lambda: shutil.which(tool))
+
+
+def read_repository_file(path):
+    """The text of `path` in the repository ("" when missing), recorded."""
+    return TAPE.take("read", path, lambda: (ROOT / path).read_text()
+                     if (ROOT / path).exists() else "")
+
+
+def run_now(cmd, env=None, cwd=ROOT, timeout=None, quiet=False):
     """Runs `cmd`; returns (return code, stdout, stderr)."""
     if not quiet:
         log("$ " + " ".join(cmd))
@@ -184,6 +266,11 @@ def bench_executables(cargo_json):
 
 
 def cpu_info():
+    """The machine's CPU, cores, caches and memory (recorded)."""
+    return TAPE.take("value", "cpu", read_cpu_info)
+
+
+def read_cpu_info():
     text = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
     fields = {}
     for line in text.split("\n\n")[0].splitlines():
@@ -233,7 +320,12 @@ def rustc_version():
     return re.sub(r"\(\s*[0-9a-f]{7,40}\s+", "(", out.strip())
 
 
-def load_average():
+def load_average(when):
+    """The load average of the last minute, recorded as `when`'s."""
+    return TAPE.take("value", f"load {when}", load_average_now)
+
+
+def load_average_now():
     try:
         return os.getloadavg()[0]
     except OSError:
@@ -263,28 +355,42 @@ class Runner:
     def build(self, benches, native=False):
         """Builds the bench binaries (so that compiling is not timed with them) and notes where
         cargo put them; with --no-build, takes the newest ones already built."""
+        found, failures, seconds = TAPE.take(
+            "build", [benches, native], lambda: self.build_now(benches, native))
+        self.build_seconds += seconds
+        for section, what in failures:
+            self.fail(section, what)
+        for name, executable in found.items():
+            self.executables[(name, native)] = Path(executable)
+        return not failures
+
+    def build_now(self, benches, native):
+        """[{bench: executable}, failures, seconds building] of [`Runner.build`]."""
+        started = time.time()
+        executables, failures = self.build_benches(benches, native)
+        return [{name: str(path) for name, path in executables.items()}, failures,
+                time.time() - started]
+
+    def build_benches(self, benches, native):
+        """({bench: executable}, [(section, failure)]) of [`Runner.build`]."""
         target = ROOT / "target" / ("native" if native else "") / "release" / "deps"
         if self.args.no_build:
+            executables, failures = {}, []
             for b in benches:
                 found = [p for p in target.glob(f"{b}-*") if p.suffix == "" and os.access(p, os.X_OK)]
                 if found:
-                    self.executables[(b, native)] = max(found, key=lambda p: p.stat().st_mtime)
+                    executables[b] = max(found, key=lambda p: p.stat().st_mtime)
                 else:
-                    self.fail("build", f"no built {b} bench in {target} (--no-build)")
-            return all((b, native) in self.executables for b in benches)
+                    failures.append(("build", f"no built {b} bench in {target} (--no-build)"))
+            return executables, failures
         cmd = ["cargo", "bench", "-p", "hairsim-benches"]
         for b in benches:
             cmd += ["--bench", b]
         cmd += ["--no-run", "--message-format=json-render-diagnostics"]
-        started = time.time()
-        rc, out, err = run(cmd, env=self.env(native))
-        self.build_seconds += time.time() - started
+        rc, out, err = run_now(cmd, env=self.env(native))
         if rc != 0:
-            self.fail("build" + (" (native)" if native else ""), tail(err))
-            return False
-        for name, executable in bench_executables(out).items():
-            self.executables[(name, native)] = executable
-        return True
+            return {}, [("build" + (" (native)" if native else ""), tail(err))]
+        return bench_executables(out), []
 
     def env(self, native=False, criterion_dir=None):
         env = dict(os.environ)
@@ -317,23 +423,29 @@ class Runner:
 
     def criterion(self, bench, filter_regex):
         """Runs criterion cases whose id matches `filter_regex`: ({full id: median ns}, text)."""
+        results, text, failure = TAPE.take("criterion", [bench, filter_regex],
+                                           lambda: self.criterion_now(bench, filter_regex))
+        if failure:
+            self.fail(bench, failure)
+        return results, text
+
+    def criterion_now(self, bench, filter_regex):
+        """[{full id: median ns}, text, failure or None] of [`Runner.criterion`]."""
         home = self.criterion_home / bench
         shutil.rmtree(home, ignore_errors=True)
         cmd = self.bench_command(bench)
         if cmd is None:
-            self.fail(bench, "not built")
-            return {}, ""
+            return {}, "", "not built"
         cmd += [filter_regex, "--noplot", *self.criterion_args]
-        rc, out, err = run(cmd, env=self.env(criterion_dir=home), cwd=ROOT / "benches")
+        rc, out, err = run_now(cmd, env=self.env(criterion_dir=home), cwd=ROOT / "benches")
         if rc != 0:
-            self.fail(bench, tail(err))
-            return {}, out + err
+            return {}, out + err, tail(err)
         results = {}
         for meta_path in home.rglob("new/benchmark.json"):
             meta = json.loads(meta_path.read_text())
             estimates = json.loads((meta_path.parent / "estimates.json").read_text())
             results[meta["full_id"]] = estimates["median"]["point_estimate"]
-        return results, out + "\n" + err
+        return results, out + "\n" + err, None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -655,75 +767,140 @@ def dftl_section(runner, bandwidth, native_runs, default_runs):
 
 
 SPH_LINE = re.compile(r"^(\S+)\s+(\d+) vertices (\S+)\s+(\d+) thread\(s\):\s+([\d.]+) M "
-                      r"vertex-steps/s wall,\s+([\d.]+) M/CPU-s,\s+([\d.]+) ms/step(.*)$", re.M)
+                      r"vertex-steps/s wall,\s+([\d.]+) M/CPU-s,\s+([\d.]+) ms/step"
+                      r"(?:, dt ([\d.]+) s)?(.*)$", re.M)
 SPH_SPLIT = re.compile(r"hash ([\d.]+), sort ([\d.]+), neighbours ([\d.]+), forces ([\d.]+); "
                        r"([\d.]+) neighbours/node \(cap (\d+), ([\d.]+) dropped/node, most "
-                       r"found (\d+)\)")
-SPH_SCENES = [("mannequin-a", "Mannequin A", 7.5), ("mannequin-b", "Mannequin B", None),
-              ("horse-louis", "Horse Louis by count", None), ("bunny", "Bunny by count", None),
-              ("hectroll", "Hectroll by count", None)]
+                       r"found (\d+)\)(?:; ([\d.]+) rebuilds per 100 steps, ([\d.]+) active/node, "
+                       r"([\d.]+) candidates/node)?")
+# Scene, label, the paper's FPS with DFTL + shape and with hair–hair too (Table 1, GTX 650),
+# and the goal for hair–hair ÷ DFTL + shape in step time.
+SPH_SCENES = [("mannequin-a", "Mannequin A", (124.0, 21.5), 2.0),
+              ("mannequin-b", "Mannequin B", (172.6, 147.4), 1.2),
+              ("horse-louis", "Horse Louis by count", None, 1.2),
+              ("bunny", "Bunny by count", None, 1.2),
+              ("hectroll", "Hectroll by count", None, 1.2)]
+# The paper's hair–hair ÷ DFTL + shape in frame time where Table 1 gives only the ratio.
+SPH_PAPER_RATIO = {"horse-louis": 1.30, "bunny": 1.30, "hectroll": 1.13}
 SPH_COLUMNS = ["dftl", "dftl+shape", "dftl+shape+hair-hair"]
+HAIR_HAIR = "dftl+shape+hair-hair"
 
 
-def sph_section(runs):
-    """`runs`: the outputs of the whole bench; medians per configuration."""
-    values, splits, vertices = {}, {}, {}
+def parse_sph(runs):
+    """{(scene, column, threads): [M vertex-steps/s]}, {same: [SPH split]}, {scene: vertices},
+    {scene: dt} from the runs' outputs."""
+    values, splits, vertices, dts = {}, {}, {}, {}
     for text in runs:
         for m in SPH_LINE.finditer(text or ""):
             key = (m.group(1), m.group(3), int(m.group(4)))
             vertices[m.group(1)] = int(m.group(2))
+            if m.group(8):
+                dts[m.group(1)] = float(m.group(8))
             values.setdefault(key, []).append(float(m.group(5)))
-            s = SPH_SPLIT.search(m.group(8))
-            if s:
-                splits.setdefault(key, []).append(s.groups())
+            split = SPH_SPLIT.search(m.group(9))
+            if split:
+                splits.setdefault(key, []).append(split.groups())
+    return values, splits, vertices, dts
+
+
+def sph_paper_ratio(scene, paper):
+    if paper:
+        return paper[0] / paper[1]
+    return SPH_PAPER_RATIO.get(scene)
+
+
+def sph_stage_rows(values, splits, vertices):
+    """The SPH stage's split on two threads, the median run (by neighbour time), per scene."""
+    rows = []
+    for scene, label, _, _ in SPH_SCENES:
+        split = splits.get((scene, HAIR_HAIR, 2))
+        if scene not in vertices or not split:
+            continue
+        split = sorted(split, key=lambda s: float(s[2]))[len(split) // 2]
+        rebuilds = split[8] if split[8] is not None else "–"
+        active = split[9] if split[9] is not None else "–"
+        rows.append([label, *split[:4], rebuilds, f"{split[4]} (cap {split[5]}, "
+                     f"{split[6]} dropped, most {split[7]})", active])
+    return rows
+
+
+def sph_section(runs, millisecond_runs):
+    """`runs`: the outputs of the whole bench at the scenes' own step; `millisecond_runs`: at
+    1 ms, two threads. Medians per configuration."""
+    values, splits, vertices, dts = parse_sph(runs)
     v = lambda scene, col, t: median(values.get((scene, col, t), []))
-    rows, ratio_rows = [], []
-    for scene, label, paper in SPH_SCENES:
+    rows, ratio_rows, goals = [], [], []
+    for scene, label, paper, goal in SPH_SCENES:
         if scene not in vertices:
             continue
         row = [f"{label} ({vertices[scene]:,})"]
         for col in SPH_COLUMNS:
             row.append(f"{num(v(scene, col, 1))} / {num(v(scene, col, 2))}")
-        row.append(str(paper) if paper else "–")
         rows.append(row)
         # Step-time ratios: time ∝ 1 / throughput.
         shape_r = [ratio(v(scene, "dftl", t), v(scene, "dftl+shape", t)) for t in (1, 2)]
-        hh_r = [ratio(v(scene, "dftl+shape", t), v(scene, "dftl+shape+hair-hair", t))
-                for t in (1, 2)]
+        hh = [v(scene, "dftl+shape", t) / v(scene, HAIR_HAIR, t)
+              if v(scene, "dftl+shape", t) and v(scene, HAIR_HAIR, t) else None for t in (1, 2)]
         threads_r = [ratio(v(scene, col, 2), v(scene, col, 1)) for col in SPH_COLUMNS]
-        split = splits.get((scene, "dftl+shape+hair-hair", 2))
-        split_text, neighbours = "–", "–"
-        if split:
-            # The split of the median run (by neighbour time).
-            split = sorted(split, key=lambda s: float(s[2]))[len(split) // 2]
-            split_text = " / ".join(split[:4])
-            neighbours = f"{split[4]} (cap {split[5]}, {split[6]} dropped, most {split[7]})"
-        ratio_rows.append([label, " / ".join(shape_r), " / ".join(hh_r), " / ".join(threads_r),
-                           split_text, neighbours])
+        paper_ratio = sph_paper_ratio(scene, paper)
+        ratio_rows.append([label, " / ".join(shape_r),
+                           " / ".join(f"{x:.2f}" if x else "–" for x in hh),
+                           f"{paper_ratio:.2f}" if paper_ratio else "–",
+                           f"{hh[1] / paper_ratio:.2f}" if hh[1] and paper_ratio else "–",
+                           " / ".join(threads_r)])
+        if hh[1]:
+            goals.append(f"{label} {hh[1]:.2f} (≤ {goal}: {verdict(hh[1] <= goal)})")
+    dt = next(iter(dts.values()), None)
     out = ["## Sánchez-Banderas 2015 Table 1 scenes: DFTL, shape and SPH hair–hair", "",
-           "Million vertex-steps per second (wall clock) of whole harness steps (`Sim`, 16-strand "
-           "blocks, SPH hair–hair interaction), one / two threads, after 30 steps of warm-up, "
-           f"over 20 steps; each the median of {len(runs)} run{'s' if len(runs) != 1 else ''} of "
-           "the whole bench. Mannequin A and B are the built-in scenes; the others are scalps "
-           "with the strand and vertex counts of the paper's models. "
-           + command_line("sph") + " (`-- mannequin-a dftl+shape+hair-hair 2t` for one cell).",
-           ""]
+           "Million vertex-steps per second (wall clock) of whole harness steps (`Sim`, "
+           "blocks of strands, SPH hair–hair interaction), one / two threads, each scene at "
+           + (f"its own step ({dt:.4f} s, the paper's 1/60 s)" if dt else "its own step")
+           + ", after half a second of warm-up, over 300 steps (so that the candidate lists' "
+           f"rebuilds are counted at their rate); each the median of {len(runs)} "
+           f"run{'s' if len(runs) != 1 else ''} of the whole bench. Mannequin A and B are the "
+           "built-in scenes; the others are scalps with the strand and vertex counts of the "
+           "paper's models. " + command_line("sph")
+           + " (`-- mannequin-a dftl+shape+hair-hair 2t` for one cell).", ""]
     if not rows:
         out.append("Not measured: the bench failed (see the command's standard error).")
         return "\n".join(out)
-    out += [table(["scene (vertices)", "DFTL", "DFTL + shape", "DFTL + shape + hair–hair",
-                   "paper, DFTL + shape + hair–hair (GTX 650)"], rows, "lrrrr"), "",
-            "Ratios, one / two threads (step times; the thread ratios for DFTL / + shape / + "
-            "hair–hair), and where the SPH stage's time goes:", "",
-            table(["scene", "DFTL + shape ÷ DFTL", "hair–hair ÷ none (÷ DFTL + shape)",
-                   "2 threads ÷ 1 thread", "SPH, 2 threads, ms: hash / sort / neighbours / "
-                   "forces", "neighbours per node"], ratio_rows, "lrrrll")]
-    a1, a2 = v("mannequin-a", "dftl+shape+hair-hair", 1), v("mannequin-a",
-                                                             "dftl+shape+hair-hair", 2)
-    if a1 and a2:
-        out += ["", f"Goal: DFTL + shape + hair–hair ≥ 8 M on Mannequin A (the paper's GTX 650: "
-                f"7.5 M): {num(a2)} M on two threads, {verdict(a2 >= 8)}; {num(a1)} M on one, "
-                f"{verdict(a1 >= 8)}."]
+    out += [table(["scene (vertices)", "DFTL", "DFTL + shape", "DFTL + shape + hair–hair"],
+                  rows, "lrrr"), "",
+            "Ratios of step times, one / two threads (the thread ratios for DFTL / + shape / + "
+            "hair–hair). The paper's hair–hair ÷ DFTL + shape is Table 1's frame times (FPS "
+            "124.0 → 21.5 and 172.6 → 147.4 for the mannequins; the ratios it gives for the "
+            "others):", "",
+            table(["scene", "DFTL + shape ÷ DFTL", "hair–hair ÷ DFTL + shape",
+                   "paper, hair–hair ÷ DFTL + shape", "hairsim ÷ paper, two threads",
+                   "2 threads ÷ 1 thread"], ratio_rows, "lrrrrr"), "",
+            "Where the SPH stage's time goes on two threads, milliseconds a step (hash: reading "
+            "the nodes, the skin's check and at a rebuild the cells; sort: at a rebuild the "
+            "counting sort, every step gathering the active particles; neighbours: at a rebuild "
+            "the candidate search, every step their filter with density; forces: pressure, "
+            "viscosity and the write-back), how often the candidate lists were rebuilt, the "
+            "neighbours a node has and the share of nodes with a candidate:", "",
+            table(["scene", "hash", "sort", "neighbours", "forces", "rebuilds per 100 steps",
+                   "neighbours per node", "active per node"],
+                  sph_stage_rows(values, splits, vertices), "lrrrrrlr")]
+    ms_values, ms_splits, ms_vertices, _ = parse_sph(millisecond_runs)
+    ms = lambda scene, col: median(ms_values.get((scene, col, 2), []))
+    ms_rows = []
+    for scene, label, _, _ in SPH_SCENES:
+        shape, both = ms(scene, "dftl+shape"), ms(scene, HAIR_HAIR)
+        if shape and both:
+            ms_rows.append([label, num(shape), num(both), f"{shape / both:.2f}"])
+    if ms_rows:
+        out += ["", "The same scenes at 1 ms, the project's rate (`-- "
+                + " ".join(SPH_MILLISECOND) + "`), two threads: M vertex-steps per second and "
+                "the ratio of step times, then the SPH stage's split:", "",
+                table(["scene", "DFTL + shape", "DFTL + shape + hair–hair",
+                       "hair–hair ÷ DFTL + shape"], ms_rows, "lrrr"), "",
+                table(["scene", "hash", "sort", "neighbours", "forces", "rebuilds per 100 steps",
+                       "neighbours per node", "active per node"],
+                      sph_stage_rows(ms_values, ms_splits, ms_vertices), "lrrrrrlr")]
+    if goals:
+        out += ["", "Goals, two threads, each scene at its own step: hair–hair ÷ DFTL + shape in "
+                "step time " + "; ".join(goals) + "."]
     return "\n".join(out)
 
 
@@ -819,6 +996,22 @@ QEMU = ["qemu-system-arm", "-cpu", "cortex-m4", "-machine", "mps2-an386", "-nogr
 SOLVER_NAMES = {"rod": "rod", "dftl": "DFTL + shape", "dftl_noshape": "DFTL, no shape"}
 
 
+def build_firmware():
+    """[return code, the firmware's ELF or None, cargo's standard error, seconds building]."""
+    started = time.time()
+    rc, out, err = run_now(["cargo", "build", "--release",
+                            "--message-format=json-render-diagnostics"], cwd=ROOT / "firmware")
+    elf = None
+    for line in out.splitlines():
+        try:
+            message = json.loads(line)
+        except ValueError:
+            continue
+        if message.get("reason") == "compiler-artifact" and message.get("executable"):
+            elf = message["executable"]
+    return [rc, elf, err, time.time() - started]
+
+
 def firmware_section(runner):
     intro = ["## Measured on the target: Cortex-M4F under QEMU", "",
              "The firmware example steps rod scenes and DFTL scenes (with shape preservation, "
@@ -832,7 +1025,7 @@ def firmware_section(runner):
              "--release`, then `" + " ".join(QEMU) + " "
              "target/thumbv7em-none-eabihf/release/hairsim-firmware > LOG` and `python3 "
              "firmware/latency.py LOG ELF`.", ""]
-    missing = [tool for tool in ("qemu-system-arm", "llvm-objdump") if not shutil.which(tool)]
+    missing = [tool for tool in ("qemu-system-arm", "llvm-objdump") if not which(tool)]
     rc, targets, _ = run(["rustup", "target", "list", "--installed"], quiet=True)
     if rc != 0 or "thumbv7em-none-eabihf" not in targets.split():
         missing.append("the thumbv7em-none-eabihf target")
@@ -840,18 +1033,8 @@ def firmware_section(runner):
         log("firmware section skipped: " + ", ".join(missing) + " missing")
         return "\n".join(intro + ["Not measured in this run: " + ", ".join(missing)
                                   + " not installed (`bash .ci/run` installs them)."])
-    started = time.time()
-    rc, out, err = run(["cargo", "build", "--release", "--message-format=json-render-diagnostics"],
-                       cwd=ROOT / "firmware")
-    runner.build_seconds += time.time() - started
-    elf = None
-    for line in out.splitlines():
-        try:
-            message = json.loads(line)
-        except ValueError:
-            continue
-        if message.get("reason") == "compiler-artifact" and message.get("executable"):
-            elf = message["executable"]
+    rc, elf, err, seconds = TAPE.take("firmware build", "firmware", build_firmware)
+    runner.build_seconds += seconds
     if rc != 0 or elf is None:
         runner.fail("firmware build", tail(err))
         return "\n".join(intro + ["Not measured: the firmware did not build."])
@@ -897,17 +1080,50 @@ def firmware_section(runner):
         f"{size('dftl')}, {verdict(largest.get('dftl', 0) >= 512)}, without shape "
         f"{size('dftl_noshape')}, {verdict(largest.get('dftl_noshape', 0) >= 512)}. "
         "What each model needs at the least: [floors](study/floors.md).")
+    collision = collision_rows(out)
+    if collision:
+        out_lines += ["", "What a collision row costs (`latency.py`'s `collision rows` lines): the "
+                      "modelled cycles the head's sphere adds to a rod scene, divided by the "
+                      "collision rows its projection solved (`StepReport::collision_rows`, each "
+                      "row counted at every iteration), the head shaking at 10 rad/s. Goal: at "
+                      "most 1.5× a collision row's floor.", "", collision]
     return "\n".join(out_lines)
+
+
+COLLISION_LINE = re.compile(r"^collision rows, rod (\d+) nodes (\S+), (\d+) steps: (\d+) rows "
+                            r"\(([\d.]+) a step\); the sphere adds (\d+) cycles a step, (\S+) a "
+                            r"row against ([\d.]+) \(1\.5 x (\d+)\): (met|missed)$", re.M)
+
+
+def collision_rows(latency_output):
+    """The table of `latency.py`'s `collision rows` lines, or ""."""
+    rows = []
+    for m in COLLISION_LINE.finditer(latency_output):
+        per_row = m.group(7)
+        rows.append([f"`{m.group(2)}` (1 × {m.group(1)})", m.group(5), f"{int(m.group(6)):,}",
+                     "—" if per_row == "inf" else f"{int(float(per_row)):,}",
+                     f"≤ {m.group(8)}: {verdict(m.group(10) == 'met')}"
+                     if per_row != "inf" else "not measurable: no contact"])
+    if not rows:
+        return ""
+    return table(["scene", "collision rows a step", "cycles the sphere adds a step",
+                  "per collision row", "goal"], rows, "lrrrl")
+
+
+def build_c_example():
+    """[return code, make's standard error, seconds building] of the C example."""
+    started = time.time()
+    rc, _, err = run_now(["make", "-s", "-C", "firmware-c", "all"])
+    return [rc, err, time.time() - started]
 
 
 def c_example_section(runner):
     """Flash, RAM and stack of the bare-metal C example (`firmware-c/`), as `bash .ci/ffi`'s last
     step measures them."""
     intro = ["## The C library and the C example on the Cortex-M4F", ""]
-    header = (ROOT / "ffi/include/hairsim.h").read_text() if (
-        ROOT / "ffi/include/hairsim.h").exists() else ""
+    header = read_repository_file("ffi/include/hairsim.h")
     define = lambda name: (re.search(rf"^#define {name} (\d+)", header, re.M) or [None, "?"])[1]
-    cargo = (ROOT / "ffi/Cargo.toml").read_text() if (ROOT / "ffi/Cargo.toml").exists() else ""
+    cargo = read_repository_file("ffi/Cargo.toml")
     release = cargo.split("[profile.release]", 1)[-1].split("\n[", 1)[0] if cargo else ""
     opt = re.search(r"^opt-level\s*=\s*(\S+)", release, re.M)
     lto = re.search(r"^lto\s*=\s*(\S+)", release, re.M)
@@ -924,19 +1140,18 @@ def c_example_section(runner):
         "high-water marks found by painting the stack before each phase.")
     intro.append("")
     missing = [tool for tool in ("arm-none-eabi-gcc", "arm-none-eabi-size", "qemu-system-arm",
-                                 "llvm-objdump", "make") if not shutil.which(tool)]
+                                 "llvm-objdump", "make") if not which(tool)]
     rc, targets, _ = run(["rustup", "target", "list", "--installed"], quiet=True)
     if rc != 0 or "thumbv7em-none-eabihf" not in targets.split():
         missing.append("the thumbv7em-none-eabihf target")
-    if shutil.which("dpkg") and run(["dpkg", "-s", "libnewlib-arm-none-eabi"], quiet=True)[0]:
+    if which("dpkg") and run(["dpkg", "-s", "libnewlib-arm-none-eabi"], quiet=True)[0]:
         missing.append("libnewlib-arm-none-eabi")
     if missing:
         log("C example section skipped: " + ", ".join(missing) + " missing")
         return "\n".join(intro + ["Not measured in this run: " + ", ".join(missing)
                                   + " not installed (`bash .ci/ffi` installs them)."])
-    started = time.time()
-    rc, _, err = run(["make", "-s", "-C", "firmware-c", "all"])
-    runner.build_seconds += time.time() - started
+    rc, err, seconds = TAPE.take("c build", "firmware-c", build_c_example)
+    runner.build_seconds += seconds
     if rc != 0:
         runner.fail("C example build", tail(err))
         return "\n".join(intro + ["Not measured: the C example did not build."])
@@ -995,11 +1210,13 @@ INTRO = """# Performance
 hairsim's speed beside the papers' tables: Kmoch, Bonanni and Magnenat-Thalmann 2009 (the rod;
 their machine a Core 2 Quad at 2.66 GHz) and Sánchez-Banderas et al. 2015 (DFTL, shape and SPH
 hair–hair; a GTX 650 GPU), then what each effect costs, the host's step latency, the
-Cortex-M4F's instruction counts, and the flash, RAM and stack of the C example. This whole file is printed by one command, which builds and
-runs every bench below and measures the machine's memory bandwidth in the same run:
+Cortex-M4F's instruction counts, and the flash, RAM and stack of the C example. This whole
+file is printed by one command, which builds and runs every bench below and measures the
+machine's memory bandwidth in the same run (`--quick`: a short trial run; `--replay
+docs/performance.json`: the same page again from what was measured, running nothing):
 
 ```sh
-python3 benches/performance.py > docs/performance.md    # --quick: a short trial run
+python3 benches/performance.py --record docs/performance.json > docs/performance.md
 ```
 
 An absolute figure belongs to the machine it was measured on, described first; the machine
@@ -1021,6 +1238,8 @@ def machine_section(args, cpu, rustc, load_start, load_end, bandwidth, wall, bui
         command += f" --runs {args.runs}"
     if args.only:
         command += f" --only {args.only}"
+    if args.record:
+        command += f" --record {args.record}"
     model = cpu["model"]
     if cpu["family"]:
         model += f" (family {cpu['family']}, model {cpu['model_number']})"
@@ -1041,7 +1260,8 @@ def machine_section(args, cpu, rustc, load_start, load_end, bandwidth, wall, bui
     rows = [
         ["command", f"`{command}`" + (" (a trial run: short measurements)" if args.quick
                                       else "")],
-        ["date", datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")],
+        ["date", TAPE.take("value", "date", lambda: datetime.datetime.now(
+            datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"))],
         ["CPU", model],
         ["cores", cores],
         ["vector extensions", vector],
@@ -1073,14 +1293,34 @@ def main():
                         help="runs of dftl_cpu and sph, medians (default 3, 1 with --quick)")
     parser.add_argument("--only", default="", help="comma-separated sections: "
                         + ", ".join(SECTIONS))
+    parser.add_argument("--record", type=Path, help="also write what was measured to this file")
+    parser.add_argument("--replay", type=Path,
+                        help="print the document again from a recording, running nothing")
     args = parser.parse_args()
+    record_to, replaying = args.record, args.replay is not None
+    if replaying:
+        recording = json.loads(args.replay.read_text())
+        TAPE.mode, TAPE.entries = "replay", recording["entries"]
+        args, record_to = argparse.Namespace(**recording["args"]), None
+    elif record_to:
+        TAPE.mode = "record"
     runs = args.runs if args.runs is not None else (1 if args.quick else 3)
     only = [s for s in args.only.split(",") if s] or SECTIONS
     unknown = [s for s in only if s not in SECTIONS]
     if unknown:
         parser.error(f"unknown sections {unknown}; known: {SECTIONS}")
+    document, failures = measure(args, runs, only)
+    print(document)
+    if record_to:
+        arguments = {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(args).items()}
+        record_to.write_text(json.dumps({"args": arguments, "entries": TAPE.entries},
+                                        indent=0) + "\n")
+    return 1 if failures and not replaying else 0
 
-    load_start = load_average()
+
+def measure(args, runs, only):
+    """Runs (or replays) every section of `only`: (the document, the failures)."""
+    load_start = load_average("start")
     log(f"load average {load_start}")
     cpu = cpu_info()
     rustc = rustc_version()
@@ -1094,53 +1334,64 @@ def main():
         native = False
 
     bandwidth_runs = [measure_bandwidth(runner)]
-    sections = {}
-    if "step" in only:
-        sections["step"] = step_section(runner)
-    if "twist" in only:
-        sections["twist"] = twist_section(runner)
-    if "projection" in only:
-        sections["projection"] = projection_section(runner)
+    # A section measured on its own: its name, and how it is measured and written.
+    single = {"step": step_section, "twist": twist_section, "projection": projection_section,
+              "effects": lambda r: effects_section(r.custom("effects", ["no-criterion-cases"])),
+              "latency": lambda r: latency_section(r.custom("latency")),
+              "firmware": firmware_section, "c": c_example_section}
+    sections = {name: write(runner) for name, write in single.items() if name in only}
     dftl_default, dftl_native = [], []
     if "dftl" in only:
         for _ in range(runs):
             dftl_default.append(parse_dftl(runner.custom("dftl_cpu")))
             if native:
                 dftl_native.append(parse_dftl(runner.custom("dftl_cpu", native=True)))
-    sph_runs = []
+    sph_runs, sph_millisecond = [], []
     if "sph" in only:
-        sph_runs = [runner.custom("sph") for _ in range(runs)]
-    if "effects" in only:
-        # The table only: a criterion filter that matches no case skips the criterion part.
-        sections["effects"] = effects_section(runner.custom("effects", ["no-criterion-cases"]))
-    if "latency" in only:
-        sections["latency"] = latency_section(runner.custom("latency"))
-    if "firmware" in only:
-        sections["firmware"] = firmware_section(runner)
-    if "c" in only:
-        sections["c"] = c_example_section(runner)
+        for _ in range(runs):
+            sph_runs.append(runner.custom("sph"))
+            sph_millisecond.append(runner.custom("sph", SPH_MILLISECOND))
     bandwidth_runs.append(measure_bandwidth(runner))
     bandwidth = best_bandwidth(bandwidth_runs)
     if "dftl" in only:
         sections["dftl"] = dftl_section(runner, bandwidth, dftl_native, dftl_default)
     if "sph" in only:
-        sections["sph"] = sph_section(sph_runs)
+        sections["sph"] = sph_section(sph_runs, sph_millisecond)
     sections["bandwidth"] = bandwidth_section(bandwidth_runs)
-    load_end = load_average()
+    load_end = load_average("end")
     log(f"load average {load_end}")
+    wall = TAPE.take("value", "wall", lambda: time.time() - START)
 
     parts = [INTRO, machine_section(args, cpu, rustc, load_start, load_end, bandwidth,
-                                    time.time() - START, runner.build_seconds)]
-    for name in ["bandwidth", "step", "twist", "projection", "dftl", "sph", "effects", "latency",
-                 "firmware", "c"]:
+                                    wall, runner.build_seconds)]
+    tables = data_tables()
+    for name in ["bandwidth"] + SECTIONS:
         if name in sections:
             parts.append(sections[name])
+        parts += [table_section(t) for t in tables if t.get("after") == name]
+    parts += [table_section(t) for t in tables if t.get("after") not in SECTIONS]
     if runner.failures:
         parts.append("## Not measured\n\n" + "\n".join(f"- {f}" for f in runner.failures))
-    print(wrap("\n\n".join(parts)))
     shutil.rmtree(runner.criterion_home, ignore_errors=True)
     log(f"done in {(time.time() - START) / 60:.1f} minutes")
-    return 1 if runner.failures else 0
+    return wrap("\n\n".join(parts)), runner.failures
+
+
+def data_tables():
+    """The tables other scripts measure, from `benches/tables/*.json`, in file-name order."""
+    return [json.loads(path.read_text()) for path in sorted((ROOT / TABLES).glob("*.json"))]
+
+
+def table_section(data):
+    """A section from a table file: its heading, text, table and the command that measured it."""
+    out = [f"## {data['title']}", ""]
+    if data.get("text"):
+        out += [data["text"], ""]
+    if data.get("command"):
+        out += [f"Measured by `{data['command']}`" + (f" on {data['date']}" if data.get("date")
+                                                      else "") + ".", ""]
+    out.append(table(data["header"], data["rows"], data.get("align")))
+    return "\n".join(out)
 
 
 if __name__ == "__main__":
