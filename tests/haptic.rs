@@ -772,3 +772,35 @@ fn a_closed_loop_gives_back_no_more_than_its_coupling_held() {
         }
     }
 }
+
+/// The example scene `scenes/tug.toml` (two grabs tug at one wisp, the tip's let go at 1 s)
+/// with `solver = "dftl"`: DFTL holds both grabs, the strand inextensible between them, and
+/// reports both forces.
+#[test]
+fn tug_holds_both_grabs_with_dftl() {
+    use hairsim::scene::Scene;
+    use hairsim::sim::{scene_inputs, Sim};
+    use hairsim_core::DefaultMath;
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/tug.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = text
+        .replace("solver = \"rod\"", "solver = \"dftl\"")
+        .replace("\"bending\", \"twist\", ", "");
+    assert!(text.contains("solver = \"dftl\"") && !text.contains("\"twist\""));
+    let (_, prepared) =
+        Scene::parse_and_prepare(&text, "tug.toml", std::path::Path::new("scenes")).unwrap();
+    let mut sim = Sim::<32, DefaultMath>::new(&prepared, 1).unwrap();
+    let mut largest: Real = 0.0;
+    for k in 0..950 {
+        let report = sim.step(&scene_inputs::<DefaultMath>(&prepared, k));
+        assert!(
+            sim.grabs.iter().all(|g| g.status == GrabStatus::Held),
+            "step {k}: {:?}",
+            sim.grabs
+        );
+        assert!(report.grab_forces[..2].iter().all(|f| f.length() > 0.0));
+        largest = largest.max(report.max_stretch);
+    }
+    println!("tug with DFTL: largest stretch {largest:.2e}");
+    assert!(largest <= 1.0e-3, "{largest}");
+}

@@ -284,18 +284,19 @@ pub mod haptic_dftl {
     /// The rest polyline of strand `s`: 16 nodes, 8 mm apart, out from a 5 cm head and
     /// curving down, with a 3 mm wave.
     fn strand<M: Math>(s: usize) -> [Vec3; NODES] {
+        core::array::from_fn(|i| rest_node::<M>(s, i))
+    }
+
+    /// Node `i` of strand `s`'s rest polyline.
+    fn rest_node<M: Math>(s: usize, i: usize) -> Vec3 {
         let angle = s as Real * 0.785;
         let (sin, cos) = M::sin_cos(angle);
         let direction = Vec3::new(0.8 * cos, 0.3, 0.8 * sin);
         let direction = direction * (1.0 / M::length(direction));
         let side = Vec3::new(-sin, 0.0, cos);
-        let mut points = [Vec3::ZERO; NODES];
-        for (i, p) in points.iter_mut().enumerate() {
-            let (wave, _) = M::sin_cos(1.3 * i as Real);
-            let droop = Vec3::new(0.0, -0.0004 * (i * i) as Real, 0.0);
-            *p = direction * (0.05 + 0.008 * i as Real) + side * (0.003 * wave) + droop;
-        }
-        points
+        let (wave, _) = M::sin_cos(1.3 * i as Real);
+        let droop = Vec3::new(0.0, -0.0004 * (i * i) as Real, 0.0);
+        direction * (0.05 + 0.008 * i as Real) + side * (0.003 * wave) + droop
     }
 
     /// Fills an empty world with the scene.
@@ -325,7 +326,7 @@ pub mod haptic_dftl {
     pub fn grab_target<M: Math>(k: u32) -> Vec3 {
         let t = k as Real * params().dt;
         let (s, c) = M::sin_cos(2.0 * core::f32::consts::PI * 2.0 * t);
-        strand::<M>(0)[GRABBED_NODE as usize] + Vec3::new(0.01 * (c - 1.0), 0.0, 0.01 * s)
+        rest_node::<M>(0, GRABBED_NODE as usize) + Vec3::new(0.01 * (c - 1.0), 0.0, 0.01 * s)
     }
 
     /// The input of step `k` (0-based): the head shaking at 10 rad/s, pose at `t = (k+1) dt`.

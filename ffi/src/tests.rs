@@ -563,3 +563,91 @@ fn refused_arguments_have_their_codes() {
         }
     }
 }
+
+/// A DFTL world with a coupled grab, through the C functions: the grab holds and renders its
+/// coupling, the head's force is reported, the state hash is the core's; a coupling out of range
+/// is refused.
+#[test]
+fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
+    use hairsim_core::{
+        Coupling, Effect, Effects, Grab as CoreGrab, Material as CoreMaterial, Params as CoreParams,
+        Pose, Solver, StepInput, Strand as CoreStrand, Vec3 as CoreVec3,
+    };
+    let params = CoreParams {
+        solver: Solver::Dftl,
+        effects: Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Drag,
+            Effect::Inextensibility,
+            Effect::Shape,
+            Effect::Grabs,
+        ]),
+        drag: 2.0e-7,
+        ..CoreParams::DEFAULT
+    };
+    let points: Vec<CoreVec3> = (0..16)
+        .map(|i| CoreVec3::new(0.01 * i as f32, 0.0, 0.0))
+        .collect();
+    let tip = points[15];
+    let target = |k: u32| tip + CoreVec3::new(-0.02, -0.01, 0.01) * (k as f32 / 200.0).min(1.0);
+    let coupling = Coupling::new(20.0, 0.01);
+    // The core, directly.
+    let mut core_world: Box<World<1, 16, DefaultMath>> = Box::default();
+    core_world.configure(params).unwrap();
+    let strand = CoreStrand::from_polyline(&points, &CoreMaterial::HUMAN_HAIR).unwrap();
+    core_world.add_strand(strand).unwrap();
+    core_world
+        .add_grab(CoreGrab::new(0, 15, tip, 1.0).with_coupling(coupling))
+        .unwrap();
+    // Through C.
+    let mut storage = Storage::new();
+    let world = storage.init();
+    let c_points: Vec<hairsim_vec3> = points.iter().map(|p| convert::vec3_to_c(*p)).collect();
+    let material = convert::material_to_c(&CoreMaterial::HUMAN_HAIR);
+    let mut grab = hairsim_grab {
+        strand: 0,
+        node: 15,
+        target: convert::vec3_to_c(tip),
+        force_limit: 1.0,
+        stiffness: 1.0e6,
+        damping: 0.01,
+    };
+    unsafe {
+        assert_eq!(hairsim_configure(world, &convert::params_to_c(&params)), E::Ok);
+        let count = c_points.len();
+        let code = hairsim_add_strand(world, c_points.as_ptr(), count, &material, ptr::null_mut());
+        assert_eq!(code, E::Ok);
+        // 1e6 N/m is past the coupling's range.
+        assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::InvalidGrab);
+        grab.stiffness = coupling.stiffness;
+        assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::Ok);
+    }
+    let mut report = core::mem::MaybeUninit::<hairsim_step_report>::uninit();
+    for k in 0..400 {
+        let t = convert::vec3_to_c(target(k + 1));
+        let mut input = input(identity());
+        input.grab_targets = &t;
+        input.grab_target_count = 1;
+        assert_eq!(unsafe { hairsim_step(world, &input, report.as_mut_ptr()) }, E::Ok);
+        core_world.set_grab_target(0, target(k + 1));
+        core_world.step(&StepInput {
+            head: Pose::IDENTITY,
+            accelerations: None,
+        });
+    }
+    let report = unsafe { report.assume_init() };
+    assert_eq!(report.grabs_slipped, 0);
+    let (grab_force, head_force) = (report.grab_forces[0], report.head_force);
+    for f in [grab_force, head_force] {
+        assert!(f.x.is_finite() && f.y.is_finite() && f.z.is_finite());
+    }
+    // Held still for the last 200 steps: the grab and the head carry the strand's weight.
+    let strand = &core_world.strands()[0];
+    let weight: f32 = strand.rest.mass[2..16].iter().sum::<f32>() * 9.81;
+    let carried = -(grab_force.y + head_force.y);
+    assert!(
+        (carried / weight - 1.0).abs() < 0.05,
+        "{grab_force:?} {head_force:?} against {weight}"
+    );
+    assert_eq!(hash(world), core_world.state_hash());
+}

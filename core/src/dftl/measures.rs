@@ -40,8 +40,7 @@ pub type ColliderPush<T> = [V3<T>; MAX_COLLIDERS];
 /// transmits is the difference ([`Tally::head_force`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Momenta<T: Lane> {
-    /// `Σ m (v + a Δt)`: at the step's end under the external forces alone (the nodes'
-    /// `Advanced::kicked`).
+    /// `Σ m (v + a Δt)`: at the step's end under the external forces alone.
     pub external: V3<T>,
     /// `Σ m v⁺`: after the pass.
     pub after: V3<T>,

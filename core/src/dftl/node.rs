@@ -219,8 +219,7 @@ pub struct Advanced<T: Lane> {
     /// Whether a collider pushed the node (its segment to the next node is then measured as
     /// a segment with contact).
     pub contact: T::Mask,
-    /// `m (v + a Δt)`: the node's momentum at the step's end under the external forces alone
-    /// (zero where the lane does not have the node): what the step's corrections change is
-    /// what the head transmits (`dftl::measures::Tally::head_force`).
-    pub kicked: V3<T>,
+    /// The node's external acceleration `a` (lines 13–14), for the head's force
+    /// (`dftl::measures::Momenta`).
+    pub acceleration: V3<T>,
 }

@@ -101,7 +101,9 @@ pub fn step_strand<M: Math, const N: usize>(
 /// gives the grabs' forces as the rod defines them. It always runs `rod.projection_iterations`
 /// (fixed cost, in either mode): a DFTL step's cost does not depend on the state, and a
 /// projection stopped at its tolerance kept a held, shaped strand trembling by 0.1 mm
-/// (`docs/design-departures.md`, "Grabs in DFTL").
+/// (`docs/design-departures.md`, "Grabs in DFTL"). Out of line: the strands no grab holds
+/// keep `step_strand` as lean as before.
+#[inline(never)]
 fn step_held_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     setup: &Setup,
@@ -278,7 +280,7 @@ fn node_loop<M: Math, const N: usize>(
         // Lines 13–21: predict, shape, follow the leader, collisions, frame.
         let (m, c) = (&mut measures, &mut *collider_push);
         let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
-        momenta.external += next.kicked;
+        momenta.external += kicked(&setup, &node, next.acceleration);
         // Lines 24–26: node i − 1 is final, node i − 2 has its whole reaction.
         if i >= 3 {
             let x = state.position[i - 1].into();
@@ -357,9 +359,6 @@ pub fn advance<M: Math, T: Lane>(
     };
     // Lines 13–14: external accelerations, prediction (eq. 1).
     let a = predict::acceleration(setup, velocity, node.mass, node.extra, node.has_extra);
-    // The momentum the node would end the step with under the external forces alone (its
-    // velocity as the step found it: the shape damping is the head's doing too).
-    let kicked = (node.velocity + a.scale(T::splat(setup.dt))).scale(node.mass);
     let mut x = predict::predicted_position(setup, node.position, velocity, a);
     // Line 18: shape, eqs. (8), (9) — the local target uses x* after the global step. Eq.
     // (14) feeds back the local and the follow-the-leader corrections, not the global one
@@ -413,8 +412,18 @@ pub fn advance<M: Math, T: Lane>(
         local,
         inextensible,
         contact,
-        kicked: V3::select(node.active, kicked, V3::zero()),
+        acceleration: a,
     }
+}
+
+/// Node `node`'s momentum at the step's end under the external forces alone, `m (v + a Δt)`
+/// with its velocity as the step found it (the shape damping is the head's doing too) and its
+/// external acceleration `a`; zero where the lane does not have the node. What the step's
+/// corrections change of it is what the head transmits (`Tally::head_force`).
+#[inline(always)]
+fn kicked<T: Lane>(setup: &Setup, node: &NodeInput<T>, a: V3<T>) -> V3<T> {
+    let kicked = (node.velocity + a.scale(T::splat(setup.dt))).scale(node.mass);
+    V3::select(node.active, kicked, V3::zero())
 }
 
 /// Steps every block of `blocks` (strand `b·W + l` of the scene is lane `l` of block `b`,
@@ -633,7 +642,7 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
         carried.measures,
         carried.collider_push,
     );
-    carried.momenta.external += next.kicked;
+    carried.momenta.external += kicked(setup, &node, next.acceleration);
     // Lines 24–26 for nodes k − 1 and k − 2; a lane past its last node hands on zeros, as
     // the per-strand path does after a strand's last node.
     let local = V3::select(active, next.local, V3::zero());
