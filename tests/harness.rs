@@ -298,7 +298,7 @@ fn a_missing_scene_is_one_clear_error() {
         .to_string();
     assert!(
         e.starts_with(
-            "no-such-scene: no such scene: not a built-in scene (firmware, firmware-dftl, stand-1"
+            "no-such-scene: no such scene: not a built-in scene (firmware, firmware-dftl, haptic-dftl, stand-1"
         ),
         "{e}"
     );

@@ -35,15 +35,16 @@ pub struct Measures<T> {
 /// `Σ m Δx^push` per collider (the push-outs, mass weighted), per lane.
 pub type ColliderPush<T> = [V3<T>; MAX_COLLIDERS];
 
-/// A strand's free nodes' momenta over a step, per lane, summed in node order as the pass goes
-/// (each node's terms where the pass has them in registers, `pipeline::dftl`): what the head
-/// transmits is the difference ([`Tally::head_force`]).
+/// What a strand's free nodes' momentum lost over a step to the corrections, per lane:
+/// `Σ m (v + a Δt) − Σ m v⁺`, the momentum each node would end the step with under the
+/// external forces alone less the momentum it ends with, summed in node order as the pass goes
+/// (each node's terms where the pass has them in registers, `pipeline::dftl`). One sum, not
+/// the two momenta apart: on the Cortex-M4F the second sum's three registers spilled in the
+/// node loop. The head transmits it, less the colliders' share ([`Tally::head_force`]).
 #[derive(Clone, Copy, Debug)]
 pub struct Momenta<T: Lane> {
-    /// `Σ m (v + a Δt)`: at the step's end under the external forces alone.
-    pub external: V3<T>,
-    /// `Σ m v⁺`: after the pass.
-    pub after: V3<T>,
+    /// `Σ m (v + a Δt) − Σ m v⁺` so far.
+    pub lost: V3<T>,
 }
 
 impl<T: Lane> Momenta<T> {
@@ -51,10 +52,7 @@ impl<T: Lane> Momenta<T> {
     #[inline(always)]
     #[must_use]
     pub fn zero() -> Self {
-        Momenta {
-            external: V3::zero(),
-            after: V3::zero(),
-        }
+        Momenta { lost: V3::zero() }
     }
 }
 
@@ -167,8 +165,8 @@ pub struct Tally {
     pub contacts: u32,
     /// `Σ m Δx^push` per collider.
     pub collider_push: [Vec3; MAX_COLLIDERS],
-    /// `Σ m (v + a Δt)` over the free nodes ([`Momenta::external`]).
-    pub external: Vec3,
+    /// `Σ m (v + a Δt) − Σ m v⁺` over the free nodes ([`Momenta::lost`]).
+    pub lost: Vec3,
     /// The force the head feels from the strand ([`Tally::head_force`]), N; the report takes
     /// it after the guard, from strands that were not rolled back.
     pub head_force: Vec3,
@@ -187,15 +185,15 @@ impl Tally {
     ) -> Self {
         let (stretch, contact_stretch) = m.stretches::<M>();
         let collider_push = collider_push.map(Vec3::from);
-        let (external, momentum) = (momenta.external.into(), momenta.after.into());
+        let lost = momenta.lost.into();
         Tally {
             stretch,
             contact_stretch,
             penetration: m.penetration,
             contacts: m.contacts as u32,
             collider_push,
-            external,
-            head_force: Self::head_force(external, momentum, &collider_push, inv_dt),
+            lost,
+            head_force: Self::head_force(lost, &collider_push, inv_dt),
         }
     }
 
@@ -204,19 +202,13 @@ impl Tally {
     /// be read off a node; what the held root nodes transmit is the change of the free
     /// nodes' momentum that the external forces and the colliders do not explain, with the
     /// opposite sign: `(Σ m (v + a Δt) − Σ m v⁺)/Δt + Σ m Δx^push/Δt²` (the colliders feel
-    /// `−Σ m Δx^push/Δt²`), `external` being the first sum and `momentum` the
-    /// second ([`Momenta`]). At rest: the weight the strand does not lay on a collider. It
+    /// `−Σ m Δx^push/Δt²`), `lost` being the difference of the sums ([`Momenta::lost`]). At rest: the weight the strand does not lay on a collider. It
     /// counts the shape springs' pull (their targets move with the head) and the damping's;
     /// the force a grab's device feels is subtracted by the caller where the strand is held.
     #[must_use]
-    pub fn head_force(
-        external: Vec3,
-        momentum: Vec3,
-        collider_push: &[Vec3; MAX_COLLIDERS],
-        inv_dt: Real,
-    ) -> Vec3 {
+    pub fn head_force(lost: Vec3, collider_push: &[Vec3; MAX_COLLIDERS], inv_dt: Real) -> Vec3 {
         let pushed = collider_push.iter().fold(Vec3::ZERO, |sum, &p| sum + p);
-        (external - momentum) * inv_dt + pushed * (inv_dt * inv_dt)
+        lost * inv_dt + pushed * (inv_dt * inv_dt)
     }
 
     /// Folds the tally into `report`: maxima and counts, and each collider's contact force

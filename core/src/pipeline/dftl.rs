@@ -140,6 +140,7 @@ fn step_held_strand<M: Math, const N: usize>(
         ..Tally::default()
     };
     pushed.report(report, ctx.colliders().len(), setup.inv_dt);
+    let unprojected_momentum = strand_momentum(strand);
     // Lines 5–8 of Kmoch's Algorithm 1: inextensibility, collisions and the grabs.
     let outcome = project_in_mode::<M, N>(strand, ctx, (grabs, index), Mode::FixedCost, report);
     let good = not_finite_sum(roots + pass) == 0.0 && strand.is_finite();
@@ -149,8 +150,8 @@ fn step_held_strand<M: Math, const N: usize>(
     }
     // What the head feels: the momentum the step gave besides the external forces, the
     // colliders' and the grabs' (the projection reports what those feel, so less that).
-    let momentum = strand_momentum(strand);
-    let head = Tally::head_force(tally.external, momentum, &tally.collider_push, setup.inv_dt)
+    let lost = tally.lost + unprojected_momentum - strand_momentum(strand);
+    let head = Tally::head_force(lost, &tally.collider_push, setup.inv_dt)
         - outcome.collider_felt
         - outcome.grab_felt;
     transmit_to_head(head, rolled_back, report);
@@ -280,7 +281,7 @@ fn node_loop<M: Math, const N: usize>(
         // Lines 13–21: predict, shape, follow the leader, collisions, frame.
         let (m, c) = (&mut measures, &mut *collider_push);
         let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
-        momenta.external += kicked(&setup, &node, next.acceleration);
+        momenta.lost += kicked(&setup, &node, next.acceleration);
         // Lines 24–26: node i − 1 is final, node i − 2 has its whole reaction.
         if i >= 3 {
             let x = state.position[i - 1].into();
@@ -290,7 +291,7 @@ fn node_loop<M: Math, const N: usize>(
             if i >= 4 {
                 state.velocity[i - 2] = finished.into();
                 velocity_total += component_sum(finished);
-                momenta.after += finished.scale(rest.mass[i - 2]);
+                momenta.lost -= finished.scale(rest.mass[i - 2]);
             }
             pending = rest_pending;
         }
@@ -329,7 +330,7 @@ fn hand_on<const N: usize>(
     match (state.velocity.get_mut(i - 2), rest.mass.get(i - 2)) {
         (Some(velocity), Some(&mass)) if i >= 4 => {
             *velocity = finished.into();
-            momenta.after += finished.scale(mass);
+            momenta.lost -= finished.scale(mass);
             component_sum(finished)
         }
         _ => 0.0,
@@ -642,7 +643,7 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
         carried.measures,
         carried.collider_push,
     );
-    carried.momenta.external += kicked(setup, &node, next.acceleration);
+    carried.momenta.lost += kicked(setup, &node, next.acceleration);
     // Lines 24–26 for nodes k − 1 and k − 2; a lane past its last node hands on zeros, as
     // the per-strand path does after a strand's last node.
     let local = V3::select(active, next.local, V3::zero());
@@ -689,8 +690,8 @@ fn hand_on_lanes<const W: usize, const N: usize>(
         .mass
         .get(k - 2)
         .map_or(Wide::splat(0.0), |m| Wide::new(*m));
-    let after = momenta.after + stored.scale(mass);
-    momenta.after = V3::select(finishing, after, momenta.after);
+    let lost = momenta.lost - stored.scale(mass);
+    momenta.lost = V3::select(finishing, lost, momenta.lost);
     Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
 }
 
@@ -734,15 +735,15 @@ fn tally_lanes<M: Math, const W: usize, const N: usize>(
         } else {
             [Vec3::ZERO; MAX_COLLIDERS]
         };
-        let (external, momentum) = (momenta.external.lane(l), momenta.after.lane(l));
+        let lost = momenta.lost.lane(l);
         let tally = Tally {
             stretch: stretch.0[l],
             contact_stretch: contact_stretch.0[l],
             penetration: measures.penetration.0[l],
             contacts: measures.contacts.0[l] as u32,
             collider_push,
-            external,
-            head_force: Tally::head_force(external, momentum, &collider_push, setup.inv_dt),
+            lost,
+            head_force: Tally::head_force(lost, &collider_push, setup.inv_dt),
         };
         tally.report(report, ctx.colliders().len(), setup.inv_dt);
         *head_force = tally.head_force;

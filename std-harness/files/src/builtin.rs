@@ -43,7 +43,7 @@ pub const BUILTINS: &[Builtin] = &[
     },
     Builtin {
         name: "haptic-dftl",
-        about: "a haptic device holds a DFTL strand's tip through a virtual coupling (50 N/m) on a 1 cm circle at 2 Hz: 8 wavy strands of 16 nodes with shape on a 5 cm head shaking at 10 rad/s, 1000 steps at 1 ms (same hash as under QEMU)",
+        about: "a device holds a DFTL strand's tip through a coupling (50 N/m) on a 1 cm circle: 8 wavy strands x 16 nodes with shape, head shaking at 10 rad/s, 1000 steps at 1 ms (same hash as under QEMU)",
         scene: haptic_dftl_scene,
     },
     Builtin {

@@ -731,11 +731,20 @@ fn the_dftl_solver_refuses_what_it_cannot_do() {
         "",
         "t.toml:6: effects[1]: the dftl solver cannot do \"bending\"",
     );
-    let grab = "[[grabs]]\nstrand = 0\nnode = 3\nforce_limit = 1.0\npath = [{ time = 0.0, target = [0.1, 0.0, 0.0] }]\n";
+    // DFTL grabs any free node, mid-strand too, and refuses the root's, as the rod does.
+    let grab = |node: u32| {
+        format!(
+            "[[grabs]]\nstrand = 0\nnode = {node}\nforce_limit = 1.0\n\
+             path = [{{ time = 0.0, target = [0.1, 0.0, 0.0] }}]\n"
+        )
+    };
+    let effects = ("[\"gravity\"]", "[\"gravity\", \"grabs\"]");
+    let text = scene(&[dftl[0], effects], &grab(3));
+    assert!(Scene::parse_and_prepare(&text, "t.toml", Path::new(".")).is_ok());
     refused(
-        &dftl,
-        grab,
-        "t.toml:14: grabs[0].node: the dftl solver cannot grab mid-strand (node 3), allowed the tip, node 4",
+        &[dftl[0], effects],
+        &grab(1),
+        "t.toml:14: grabs[0].node: node 1 is not a free node of strand 0, allowed 2 to 4",
     );
 }
 
