@@ -13,8 +13,11 @@ protocol through a pipe (no driver, no websocket library).
     file, the old scene still running), a scene file with the hair file it names, and one
     without it;
   - a drag on a strand with synthetic mouse events: the grab force points toward the hand's
-    target, grows as the drag lengthens, and is zero after release; a grab pulled out of
-    reach slips, is drawn and marked on the plot, and a second press re-grabs it;
+    target, grows as the drag lengthens, and is zero after release, on the rod (stand-1) and
+    on DFTL (sintel_hair.tfx dropped: the strand follows, the force is plotted); the mouse grab
+    is coupled: pulled 5 cm past the strand's reach it holds with the spring's force, pulled on
+    it slips at its force limit, is drawn and marked on the plot, and a second press re-grabs
+    it;
   - the rod with inextensibility off: stretch and roll-backs shown, "stuck" after a second of
     every strand rolled back; ticked back on, the hair recovers;
   - time: after a 15 s stall (the page's clock moved on at once) the page drops the lag and
@@ -25,8 +28,9 @@ protocol through a pipe (no driver, no websocket library).
     strands shaded (many hair tones), docs/pictures/viewer.png.
 
 Usage: viewer-test.py HAIRSIM_BINARY [--screenshot FILE] [--sweep] [--speed ROUNDS]
-  --sweep: also find how many strands of each solver keep real time (for the docs; slow);
-    --sweep-out FILE writes what it found as JSON (docs/data/viewer-sweep.json).
+  --sweep: also find how many strands of each solver keep real time (for the docs; about a
+    minute); --sweep-out FILE writes what it found as a table for benches/performance.py
+    (benches/tables/viewer.json, which docs/performance.md shows).
   --speed ROUNDS: rounds of the page-against-native stepping cost (default 1).
   --only WORDS: the checks whose titles contain one of these comma-separated words.
   --url URL: test the page at URL instead of the one `hairsim view` serves.
@@ -46,6 +50,9 @@ import zlib
 HAIR_FILE = "sintel_hair.tfx"
 # (scene, steps) whose hashes are compared with the native run.
 HASH_SCENES = [("firmware", 1000), ("firmware-dftl", 1000), ("head-2", 100)]
+# DFTL strands held by grabs (two coupled, one prescribed): a block holding one steps strand by
+# strand. Dropped on the page as a scene file.
+HELD_SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "scenes", "dftl-grabs.toml")
 REALTIME_SECONDS = 5.0
 
 
@@ -344,11 +351,14 @@ def check_hashes(binary, page, samples):
             expected = native_hash(binary, scene, steps)
             print(f"  {label:8} {scene:14} {steps:5} steps: page {page_hash}, native {expected}")
             assert page_hash == expected, f"{scene} ({label}): the page's state hash differs from the native run"
-        page.drop([(HAIR_FILE, read_sample(samples))])
-        page_hash = page.hash_after(100)
-        expected = native_hash(binary, os.path.join(samples, HAIR_FILE), 100)
-        print(f"  {label:8} {HAIR_FILE:14}   100 steps: page {page_hash}, native {expected} (dropped on the page)")
-        assert page_hash == expected, f"{HAIR_FILE} ({label}): the page's state hash differs from the native run"
+        dropped = [((HAIR_FILE, read_sample(samples)), os.path.join(samples, HAIR_FILE), 100),
+                   ((os.path.basename(HELD_SCENE), open(HELD_SCENE, "rb").read()), HELD_SCENE, 1500)]
+        for file, path, steps in dropped:
+            page.drop([file])
+            page_hash = page.hash_after(steps)
+            expected = native_hash(binary, path, steps)
+            print(f"  {label:8} {file[0]:14} {steps:5} steps: page {page_hash}, native {expected} (dropped on the page)")
+            assert page_hash == expected, f"{file[0]} ({label}): the page's state hash differs from the native run"
     page.navigate()
 
 
@@ -489,13 +499,29 @@ DRAG_SCENE, DRAG_STRAND, DRAG_NODE, DRAG_SETTLE_STEPS = "stand-1", 0, 10, 3000
 DRAG_CM = [0.5, 1.0, 1.5, 2.0]
 
 
+def vector(a, b):
+    return [x - y for x, y in zip(a, b)]
+
+
+def norm(v):
+    return sum(x * x for x in v) ** 0.5
+
+
+def pixels_per_cm(page, x, y):
+    """Pixels per centimetre at the held node's depth, from a small diagonal move of the
+    pointer pressed at (x, y) (the pointer is left there)."""
+    start = page.status()["grab_target"]
+    page.b.mouse("mouseMoved", x + 7, y - 7)
+    return 7 / (100 * norm(vector(page.status()["grab_target"], start)))
+
+
 def check_drag(page):
     """Grabs a settled, hanging wisp of stand-1 10 cm below its root with the mouse and drags
     it up and sideways on the screen by 0.5, 1, 1.5 and 2 cm, holding each for 1 s of simulated
     time. (Further, the wisp folds over the hand and the force levels off; straight away from
-    the root, an inextensible strand is soon out of the hand's reach and slips.) The page is
-    paused and stepped by the test (`runSteps`), so the forces are the same bits on every
-    machine; the mouse events go through the page's own handlers."""
+    the root, an inextensible strand is soon pulled taut and the grab's spring stretches.) The
+    page is paused and stepped by the test (`runSteps`), so the forces are the same bits on
+    every machine; the mouse events go through the page's own handlers."""
     page.load(DRAG_SCENE)
     page.b.evaluate(f"hairsim.pause(true); hairsim.reset(); hairsim.runSteps({DRAG_SETTLE_STEPS})")
     x, y, _ = page.b.evaluate(f"hairsim.screen({DRAG_STRAND}, {DRAG_NODE})")
@@ -503,58 +529,124 @@ def check_drag(page):
     first = page.status()
     assert first["grab"] == "held", f"pressing on a strand grabbed nothing: {first['grab']}"
     start = first["grab_target"]
-    # Pixels per centimetre at the grabbed node's depth, from a small diagonal move.
-    page.b.mouse("mouseMoved", x + 7, y - 7)
-    moved = [t - s for t, s in zip(page.status()["grab_target"], start)]
-    pixels_per_cm = 7 / (100 * sum(d * d for d in moved) ** 0.5)
+    per_cm = pixels_per_cm(page, x, y)
     magnitudes = []
     for cm in DRAG_CM:
-        page.b.mouse("mouseMoved", x + cm * pixels_per_cm, y - cm * pixels_per_cm)
+        page.b.mouse("mouseMoved", x + cm * per_cm, y - cm * per_cm)
         # 0.5 s to follow the hand, then the force every 10 steps for 0.5 s.
         page.b.evaluate("hairsim.runSteps(500)")
         forces = page.b.evaluate(
             "Array.from({length: 50}, () => { hairsim.runSteps(10); return hairsim.status().grab_force; })"
         )
         status = page.status()
-        drag = [t - s for t, s in zip(status["grab_target"], start)]
-        length = sum(d * d for d in drag) ** 0.5
+        drag = vector(status["grab_target"], start)
+        length = norm(drag)
         mean = [sum(f[i] for f in forces) / len(forces) for i in range(3)]
         along = sum(f * d for f, d in zip(mean, drag)) / length
-        magnitude = sum(f * f for f in mean) ** 0.5
+        magnitude = norm(mean)
         print(f"  drag {100 * length:.1f} cm: mean force {magnitude:.3e} N,"
               f" {along / magnitude if magnitude else 0:.3f} of it along the drag, grab {status['grab']}")
         assert status["grab"] == "held", f"the grab let go: {status['grab']}"
         assert along > 0.5 * magnitude > 0, "the grab force does not point toward the target"
         magnitudes.append(magnitude)
     assert all(b > a for a, b in zip(magnitudes, magnitudes[1:])), f"the force does not grow: {magnitudes}"
-    page.b.mouse("mouseReleased", x + DRAG_CM[-1] * pixels_per_cm, y - DRAG_CM[-1] * pixels_per_cm)
+    page.b.mouse("mouseReleased", x + DRAG_CM[-1] * per_cm, y - DRAG_CM[-1] * per_cm)
     after = page.status()
     assert after["grab_force"] == [0, 0, 0] and after["grab"] != "held", after
     print(f"  released: grab {after['grab']}, force {after['grab_force']}")
 
 
+def check_dftl_drag(page, samples):
+    """DFTL hair as a user meets it: sintel_hair.tfx dropped on the page (DFTL, shape on),
+    settled, a strand pressed and dragged 1.5 cm up and 1 cm sideways: the held node follows
+    the hand (within 2 mm after 0.3 s), the force is nonzero and plotted."""
+    page.drop([(HAIR_FILE, read_sample(samples))])
+    status = page.status()
+    assert status["solver"] == "dftl", status["solver"]
+    page.b.evaluate("hairsim.pause(true); hairsim.reset(); hairsim.runSteps(200)")
+    x, y, _ = page.b.evaluate("hairsim.screen(0, 8)")
+    page.b.mouse("mousePressed", x, y)
+    held = page.status()
+    assert held["grab"] == "held", f"pressing on a DFTL strand grabbed nothing: {held['grab']} ({page.error()})"
+    strand, node = held["held"]["strand"], held["held"]["node"]
+    before = held["held"]["position"]
+    per_cm = pixels_per_cm(page, x, y)
+    page.b.mouse("mouseMoved", x + 1.0 * per_cm, y - 1.5 * per_cm)
+    page.b.evaluate("hairsim.runSteps(300)")
+    time.sleep(0.3)
+    status = page.status()
+    now, target = status["held"]["position"], status["grab_target"]
+    moved, lag = norm(vector(now, before)), norm(vector(now, target))
+    force = norm(status["grab_force"])
+    print(f"  {HAIR_FILE}: strand {strand} node {node} dragged {100 * norm(vector(target, before)):.1f} cm:"
+          f" it moved {100 * moved:.2f} cm and is {1000 * lag:.2f} mm from the hand; force {force:.3e} N,"
+          f" plotted {status['plotted']['samples']} samples up to {status['plotted']['max']:.3e} N, grab {status['grab']}")
+    assert status["grab"] == "held", status["grab"]
+    assert moved > 0.015 and lag < 0.002, "the strand does not follow the hand"
+    assert force > 0 and status["plotted"]["max"] > 0, "no force shown"
+    page.b.mouse("mouseReleased", x + 1.0 * per_cm, y - 1.5 * per_cm)
+    assert page.status()["grab"] == "none"
+
+
 def check_slip_and_regrab(page):
-    """Grabs the same wisp and pulls the hand 30 cm away, out of its reach: the grab slips
-    (drawn, marked on the force plot, a warning); a second press, without letting go,
-    grabs it again."""
+    """The mouse grab is coupled. Grabs the same wisp and pulls it straight down, 5 cm past its
+    reach (a prescribed grab slipped there at once): it holds, the strand taut, with the
+    spring's force K |x − T|. Pulled on down, it slips when that force passes its limit (drawn,
+    marked on the force plot, a warning); a second press, without letting go, grabs it again."""
     page.load(DRAG_SCENE)
     page.b.evaluate(f"hairsim.pause(true); hairsim.reset(); hairsim.runSteps({DRAG_SETTLE_STEPS})")
     x, y, _ = page.b.evaluate(f"hairsim.screen({DRAG_STRAND}, {DRAG_NODE})")
     page.b.mouse("mousePressed", x, y)
-    page.b.evaluate("hairsim.runSteps(200)")
-    assert page.status()["grab"] == "held"
-    away = x + 400
-    page.b.mouse("mouseMoved", away, y)
-    page.b.evaluate("hairsim.pause(false)")
-    end = time.time() + 10
-    while time.time() < end and page.status()["grab"] != "slipped":
-        time.sleep(0.1)
-    time.sleep(0.2)
     status = page.status()
-    assert status["grab"] == "slipped", f"pulled out of reach, the grab did not slip: {status['grab']}"
-    assert status["slips"] >= 1, "the slip is not marked on the force plot"
-    assert any("slipped" in w for w in status["warnings"]), status["warnings"]
-    page.b.evaluate("hairsim.pause(true)")
+    assert status["grab"] == "held"
+    stiffness, limit = status["grab_coupling"][0], status["grab_limit"]
+    # The arc length from node 1 (the head holds nodes 0 and 1) to the held node.
+    nodes = [page.b.evaluate(f"hairsim.node({DRAG_STRAND}, {n})") for n in range(1, DRAG_NODE + 1)]
+    reach = sum(norm(vector(b, a)) for a, b in zip(nodes, nodes[1:]))
+    per_cm = pixels_per_cm(page, x, y)
+
+    # Down and to the right on the screen: room for the 20 cm the spring stretches to its limit.
+    direction = (0.8, 0.6)
+
+    def point(pixels):
+        return x + direction[0] * pixels, y + direction[1] * pixels
+
+    def pull(pixels):
+        """The pointer `pixels` along `direction`; how far past the reach it is, m."""
+        page.b.mouse("mouseMoved", *point(pixels))
+        return norm(vector(page.status()["grab_target"], nodes[0])) - reach
+
+    # 5 cm past the reach: a bisection on the pointer's distance.
+    low, high = 0.0, 60 * per_cm
+    for _ in range(20):
+        middle = (low + high) / 2
+        low, high = (middle, high) if pull(middle) < 0.05 else (low, middle)
+    past = pull(high)
+    page.b.evaluate("hairsim.runSteps(1000)")
+    status = page.status()
+    stretch = norm(vector(status["held"]["position"], status["grab_target"]))
+    force = norm(status["grab_force"])
+    print(f"  {100 * past:.1f} cm past its reach ({100 * reach:.1f} cm of hair): grab {status['grab']},"
+          f" the spring stretched {100 * stretch:.2f} cm, {force:.3f} N (K |x - T| = {stiffness * stretch:.3f} N)")
+    assert status["grab"] == "held", f"past its reach, the coupled grab let go: {status['grab']}"
+    assert stretch > 0.9 * past, f"the strand gave {stretch} m of {past} m"
+    assert abs(force - stiffness * stretch) < 0.02 * force, f"{force} N against K |x - T| = {stiffness * stretch} N"
+    # On, 1 cm every 0.1 s of simulated time, until the grab lets go.
+    pixels = high
+    while status["grab"] == "held":
+        pixels += per_cm
+        px, py = point(pixels)
+        assert px < 1280 and py < 800, f"the grab held to the edge of the page: {status}"
+        pull(pixels)
+        page.b.evaluate("hairsim.runSteps(100)")
+        status = page.status()
+    slipped = wait_for(page, lambda s: s["slips"] >= 1 and any("slipped" in w for w in s["warnings"]), 5,
+                       "the slip not marked on the force plot and warned")
+    held = float(slipped["warnings"][-1].split("holding ")[1].split(" N")[0])
+    print(f"  slipped {100 * (norm(vector(status['grab_target'], nodes[0])) - reach):.1f} cm past its reach,"
+          f" holding {held:.3f} N (limit {limit} N, {limit / stiffness * 100:.0f} cm of spring)")
+    assert status["grab"] == "slipped"
+    assert 0.9 * limit <= held <= limit, f"slipped holding {held} N, limit {limit} N"
     # The second press (the other button: the first is still down) lands where the strand
     # now is.
     sx, sy, _ = page.b.evaluate(f"hairsim.screen({DRAG_STRAND}, {DRAG_NODE})")
@@ -564,7 +656,7 @@ def check_slip_and_regrab(page):
     assert again["grab"] == "held", f"a second press did not re-grab: {again['grab']}"
     page.b.mouse("mouseReleased", sx, sy, button="right", buttons=1)
     page.b.mouse("mouseReleased", sx, sy)
-    print(f"  out of reach: slipped ({status['warnings'][-1]}); a second press re-grabbed: {again['grab']}")
+    print(f"  {slipped['warnings'][-1]!r}; a second press re-grabbed: {again['grab']}")
 
 
 def wait_for(page, predicate, seconds, what):
@@ -713,16 +805,19 @@ def sweep(page, out):
     that the page steps in real time: the page's stepping cost (`hairsim.benchmark`, the median
     over batches, robust to a busy machine's hiccups, which the real-time ratio over a second is
     not) at most SWEEP_BUDGET_US per 1 ms step; doubling, then halving the gap to within 5 %.
-    Writes the result as JSON to `out`."""
-    found = {}
+    Writes the result to `out` as a table of benches/performance.py (see its docstring)."""
+    load_start = os.getloadavg()[0]
+    rows = []
     for solver, effects in SWEEP_EFFECTS.items():
+        costs = {}
+
         def keeps_up(leaders):
             name = f"sweep-{solver}-{leaders}.toml"
             text = SWEEP_SCENE.format(solver=solver, leaders=leaders, effects=json.dumps(effects))
             page.drop([(name, text.encode())])
-            cost = page.b.evaluate("hairsim.pause(true), hairsim.benchmark(300)")
-            print(f"  {solver:4} {leaders:5} strands: {cost:8.1f} us per 1 ms step")
-            return cost <= SWEEP_BUDGET_US
+            costs[leaders] = page.b.evaluate("hairsim.pause(true), hairsim.benchmark(300)")
+            print(f"  {solver:4} {leaders:5} strands: {costs[leaders]:8.1f} us per 1 ms step")
+            return costs[leaders] <= SWEEP_BUDGET_US
 
         good, bad = 0, 8
         while keeps_up(bad):
@@ -734,16 +829,38 @@ def sweep(page, out):
             else:
                 bad = middle
         print(f"  {solver}: {good} strands keep real time, {bad} do not")
-        found[solver] = {"keep_real_time": good, "fall_behind": bad}
+        label = {"rod": "rod", "dftl": "DFTL"}[solver]
+        shown = ", ".join(e for e in effects if e not in ("gravity", "drag", "inextensibility"))
+        rows.append([label, shown, str(good), f"{costs.get(good, 0):.0f}", str(bad), f"{costs[bad]:.0f}"])
     if out:
         status = page.status()
         cpu = next((line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name")), "?")
-        found.update({
-            "scene": "30-node, 30 cm strands on a head shaking at 10 rad/s, 1 kHz, a 10 cm sphere",
-            "step_budget_us": SWEEP_BUDGET_US, "cpu": cpu, "cores": os.cpu_count(),
-            "module": status["module"], "renderer": status["renderer"],
-        })
-        json.dump(found, open(out, "w"), indent=1)
+        module = "with `simd128`" if "simd" in status["module"] else "without SIMD"
+        table = {
+            "title": "Strands each solver keeps in real time in the browser",
+            "after": "latency",
+            "text": (
+                "`hairsim view`'s page steps the strands in WebAssembly (the module "
+                f"{module}, one thread, in the native harness's lanes) and draws them ({status['renderer']}). "
+                f"A strand count keeps real time when stepping takes at most {SWEEP_BUDGET_US} µs of each "
+                "1 ms step, the rest left for drawing: the median of the page's `hairsim.benchmark` over "
+                "batches of at least 2 ms, 300 steps after a warm-up. The scene: 30-node, 30 cm strands "
+                "on a head shaking at 10 rad/s, at 1 kHz, with gravity, drag, inextensibility and a 10 cm "
+                "head sphere; counts doubled from 8, then bisected to within 5 %. "
+                f"Machine: {cpu}, {os.cpu_count()} logical cores, headless Chromium; load average "
+                f"(1 minute) {load_start:.1f} at the start and {os.getloadavg()[0]:.1f} at the end"
+                + (" (other processes shared the machine: the counts may be low)."
+                   if max(load_start, os.getloadavg()[0]) > 1 else ".")),
+            "command": "python3 .ci/viewer-test.py target/release/hairsim --sweep --only strands"
+                       " --sweep-out benches/tables/viewer.json",
+            "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+            "header": ["solver", "effects", "strands kept in real time", "µs per step",
+                       "strands that fall behind", "µs per step"],
+            "align": "llrrrr",
+            "rows": rows,
+        }
+        json.dump(table, open(out, "w"), indent=1, ensure_ascii=False)
+        open(out, "a").write("\n")
         print(f"  written to {out}")
 
 
@@ -813,6 +930,7 @@ def main():
             ("every effect box", lambda: check_effect_boxes(page)),
             ("drops", lambda: check_drops(page, samples)),
             ("grab and drag with the mouse", lambda: check_drag(page)),
+            ("grab and drag DFTL hair", lambda: check_dftl_drag(page, samples)),
             ("a grab that slips, re-grabbed", lambda: check_slip_and_regrab(page)),
             ("inextensibility off and on again", lambda: check_stall_and_recovery(page)),
             ("a 15 s stall, no catch-up", lambda: check_time(page)),

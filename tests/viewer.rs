@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use hairsim::run::{load, run, HairFileOptions, RunOptions};
 use hairsim_core::{Effect, Solver, Vec3};
-use hairsim_viewer::session::{Session, Source};
+use hairsim_viewer::session::{Session, Source, HAND_COUPLING, HAND_FORCE_LIMIT};
 
 /// `hairsim run SCENE --steps N`'s state hash.
 fn native_hash(scene: &str, steps: u64) -> String {
@@ -40,6 +40,30 @@ fn builtin_scenes_give_the_bits_of_hairsim_run() {
         let page = viewer_hash(Source::builtin(scene).unwrap(), steps);
         assert_eq!(page, native_hash(scene, u64::from(steps)), "{scene}");
     }
+}
+
+/// DFTL strands held by grabs (two coupled, one prescribed) on a turning head: a block holding
+/// a grabbed strand steps strand by strand, in the page as in `hairsim run`.
+#[test]
+fn dftl_strands_held_by_grabs_give_the_bits_of_hairsim_run() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/dftl-grabs.toml");
+    let source = Source::SceneFile {
+        name: "dftl-grabs.toml".into(),
+        text: std::fs::read_to_string(path).unwrap(),
+        hair: None,
+    };
+    let loaded = load(path, &HairFileOptions::default()).unwrap();
+    let options = RunOptions {
+        threads: 2,
+        ..RunOptions::default()
+    };
+    let native = run(&loaded, &options).unwrap();
+    // The grabs hold throughout.
+    assert_eq!(
+        native.grab_status.as_deref(),
+        Some(&["held"; 3].map(String::from)[..])
+    );
+    assert_eq!(viewer_hash(source, 1500), native.state_hash);
 }
 
 #[test]
@@ -80,12 +104,14 @@ fn switches_go_through_the_scenes_checks() {
     session.set_solver(Solver::Dftl).unwrap();
     assert_eq!(session.steps(), 0);
     assert_eq!(session.status()["solver"], "dftl");
-    assert!(session.grab(0, 5).is_err(), "DFTL has no grab");
+    session.grab(0, 5).unwrap();
+    session.step(10);
+    assert_eq!(session.status()["grab"], "held");
 }
 
-#[test]
-fn the_hand_pulls_the_hair_toward_its_target_harder_the_further_it_drags() {
-    // A scene file as the page gets it (by text): one 30 cm hair, let hang for 3 s.
+/// One 30 cm hair held at its root (`scenes/one-hair.toml`, as the page gets a scene file), let
+/// hang for 3 s with `solver`.
+fn one_hanging_hair(solver: Solver) -> Session {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenes/one-hair.toml");
     let source = Source::SceneFile {
         name: "one-hair.toml".into(),
@@ -93,42 +119,138 @@ fn the_hand_pulls_the_hair_toward_its_target_harder_the_further_it_drags() {
         hair: None,
     };
     let mut session = Session::load(source).unwrap();
+    session.set_solver(solver).unwrap();
     session.step(3000);
+    session
+}
+
+/// Node `node` of strand 0 where it is, m.
+fn node_position(session: &Session, node: usize) -> Vec3 {
     let mut positions = Vec::new();
     let mut offsets = Vec::new();
     session.positions(&mut positions, &mut offsets);
-    // A middle node, dragged sideways and up: toward the root's height, so the target
-    // stays within the strand's reach (a target out of reach lets go).
-    let node = (offsets[1] - offsets[0]) as usize / 2;
     let at = 3 * (offsets[0] as usize + node);
-    let start = Vec3::new(positions[at], positions[at + 1], positions[at + 2]);
-    session.grab(0, node).unwrap();
-    let direction = Vec3::new(1.0, 1.0, 0.0).normalize();
-    let mut magnitudes = Vec::new();
-    for k in 1..=4 {
-        let target = start + direction * (0.01 * k as f32);
-        session.move_hand(target);
-        session.step(1000);
-        // The mean over 0.5 s: the hanging part still swings a little.
-        let mut sum = Vec3::ZERO;
-        for _ in 0..500 {
-            session.step(1);
-            let status = session.status();
-            assert_eq!(status["grab"], "held", "drag {k}");
-            let f = &status["grab_force"];
-            let component = |i: usize| f[i].as_f64().unwrap() as f32;
-            sum += Vec3::new(component(0), component(1), component(2));
+    Vec3::new(positions[at], positions[at + 1], positions[at + 2])
+}
+
+/// A component of the status's vector `key`.
+fn status_vector(status: &serde_json::Value, key: &str) -> Vec3 {
+    let component = |i: usize| status[key][i].as_f64().unwrap() as f32;
+    Vec3::new(component(0), component(1), component(2))
+}
+
+#[test]
+fn the_hand_pulls_the_hair_toward_its_target_harder_the_further_it_drags() {
+    for solver in [Solver::Rod, Solver::Dftl] {
+        let mut session = one_hanging_hair(solver);
+        // A middle node, dragged sideways and up.
+        let node = 15;
+        let start = node_position(&session, node);
+        session.grab(0, node).unwrap();
+        // Up and toward the root's side: within the strand's reach, hanging (the rod) or held
+        // out along +x by its rest shape (DFTL).
+        let direction = Vec3::new(-1.0, 1.0, 0.0).normalize();
+        let mut magnitudes = Vec::new();
+        for k in 1..=4 {
+            let target = start + direction * (0.01 * k as f32);
+            session.move_hand(target);
+            session.step(1000);
+            // The strand follows: the node within 1 mm of the hand.
+            let lag = (node_position(&session, node) - target).length();
+            assert!(
+                lag < 1.0e-3,
+                "{solver:?} drag {k}: the node is {lag} m from the hand"
+            );
+            // The mean over 0.5 s: the hanging part still swings a little.
+            let mut sum = Vec3::ZERO;
+            for _ in 0..500 {
+                session.step(1);
+                let status = session.status();
+                assert_eq!(status["grab"], "held", "{solver:?} drag {k}");
+                sum += status_vector(&status, "grab_force");
+            }
+            let force = sum / 500.0;
+            eprintln!("{solver:?} drag {k}: {force}, the node {lag:.1e} m from the hand");
+            assert!(force.dot(direction) > 0.0, "{solver:?} drag {k}: {force}");
+            magnitudes.push(force.length());
         }
-        let force = sum / 500.0;
-        eprintln!("drag {k}: {force}");
-        assert!(force.dot(direction) > 0.0, "drag {k}: {force}");
-        magnitudes.push(force.length());
+        assert!(
+            magnitudes.windows(2).all(|w| w[1] > w[0]),
+            "{solver:?}: {magnitudes:?}"
+        );
+        session.release();
+        session.step(1);
+        assert_eq!(session.status()["grab"], "none");
+        assert_eq!(session.status()["grab_force"][0], 0.0);
     }
-    assert!(magnitudes.windows(2).all(|w| w[1] > w[0]), "{magnitudes:?}");
-    session.release();
-    session.step(1);
-    assert_eq!(session.status()["grab"], "none");
-    assert_eq!(session.status()["grab_force"][0], 0.0);
+}
+
+/// The hand's grab is coupled (`session::HAND_COUPLING`): pulled straight down past the
+/// strand's reach, it holds, the strand taut and inextensible, with the spring's force
+/// `K |x − T|`; pulled on, it slips when that force passes `HAND_FORCE_LIMIT`, not before.
+#[test]
+fn the_hand_holds_past_the_strands_reach_and_slips_only_on_its_force_limit() {
+    let stiffness = HAND_COUPLING.stiffness;
+    for solver in [Solver::Rod, Solver::Dftl] {
+        let mut session = one_hanging_hair(solver);
+        let tip = 30;
+        let root = node_position(&session, 1);
+        // The rest arc length from node 1 to the tip: 29 segments of 1 cm.
+        let reach = 0.29;
+        session.grab(0, tip).unwrap();
+        // 5 cm past the reach (a prescribed grab slips at once), reached over 0.5 s.
+        let down = Vec3::NEG_Y;
+        let past = |d: f32| root + down * (reach + d);
+        let start = node_position(&session, tip);
+        for k in 1..=500 {
+            let d = (past(0.05) - start) * (k as f32 / 500.0);
+            session.move_hand(start + d);
+            session.step(1);
+        }
+        session.step(500);
+        let status = session.status();
+        assert_eq!(status["grab"], "held", "{solver:?}: 5 cm past its reach");
+        let stretch = (node_position(&session, tip) - past(0.05)).length();
+        let force = status_vector(&status, "grab_force");
+        let segment_stretch = status["report"]["max_stretch"].as_f64().unwrap();
+        eprintln!(
+            "{solver:?}: 5 cm past the reach, held: the spring stretched {stretch:.4} m, {:.4} N; \
+             segments stretched {segment_stretch:.1e}",
+            force.length(),
+        );
+        assert!(stretch > 0.049, "{solver:?}: the strand gave {stretch} m");
+        let expected = stiffness * stretch;
+        assert!(
+            (force.length() - expected).abs() < 0.01 * expected,
+            "{solver:?}: {force} against K |x − T| = {expected}"
+        );
+        assert!(segment_stretch < 1.0e-3, "{solver:?}: {segment_stretch}");
+        // On, 0.1 mm a step: the force grows by 5e-4 N a step and passes the limit 20 cm
+        // past the reach.
+        session.take_events();
+        let mut slipped_at = None;
+        for step in 1..=4000 {
+            session.move_hand(past(0.05 + 1.0e-4 * step as f32));
+            session.step(1);
+            if session.status()["grab"] == "slipped" {
+                slipped_at = Some(0.05 + 1.0e-4 * step as f32);
+                break;
+            }
+        }
+        let slipped_at = slipped_at.expect("pulled far past the force limit, the grab held");
+        let held = session.take_events()["slipped_at"].as_f64().unwrap() as f32;
+        eprintln!("{solver:?}: slipped {slipped_at:.4} m past the reach, holding {held:.4} N");
+        let limit = HAND_FORCE_LIMIT;
+        assert!(
+            (0.99 * limit..=limit).contains(&held),
+            "{solver:?}: {held} N"
+        );
+        let expected = limit / stiffness;
+        assert!(
+            (slipped_at - expected).abs() < 0.01,
+            "{solver:?}: {slipped_at} m"
+        );
+    }
 }
 
 /// The rod with inextensibility off stretches its strands many times over until every strand

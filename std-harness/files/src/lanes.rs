@@ -1,10 +1,9 @@
 //! What the harness's threads and the page's single thread share to step strands in lanes:
-//! the lanes' square root ([`VectorSqrt`]) and a DFTL block's state copied in from its strands
-//! ([`load_state`]). The core's block paths give the bits of its per-strand path; these keep
-//! them so.
+//! the lanes' widths and their square root ([`VectorSqrt`]). The core's block paths give the
+//! bits of its per-strand path; this keeps them so.
 
-use hairsim_core::dftl::{DftlBlock, RECOMMENDED_LANES};
-use hairsim_core::{Math, Real, Strand};
+use hairsim_core::dftl::RECOMMENDED_LANES;
+use hairsim_core::{Math, Real};
 
 /// Lanes of the DFTL blocks.
 pub const DFTL_LANES: usize = RECOMMENDED_LANES;
@@ -34,11 +33,4 @@ impl<M: Math> Math for VectorSqrt<M> {
     fn atan2(y: Real, x: Real) -> Real {
         M::atan2(y, x)
     }
-}
-
-/// Copies the state (positions, velocities) of `strands` into the lanes of `block` they were
-/// loaded into (lane `l` from `strands[l]`): the inverse of [`DftlBlock::store`]. The rest
-/// data stays as loaded.
-pub fn load_state<const N: usize>(block: &mut DftlBlock<DFTL_LANES, N>, strands: &[Strand<N>]) {
-    block.load_state(strands);
 }

@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use hairsim_core::{DefaultMath, Effect, GrabStatus, Real, Shape, Solver, Vec3};
+use hairsim_core::{Coupling, DefaultMath, Effect, GrabStatus, Real, Shape, Solver, Vec3};
 use hairsim_files::builtin;
 use hairsim_files::hairscene::{scene_for_hair_file_in, HairFileOptions};
 use hairsim_files::scene::start::scene_inputs;
@@ -18,9 +18,26 @@ use serde_json::{json, Value};
 
 use crate::stepper::{Events, Stepper};
 
-/// Largest force the hand's grab transmits before it slips, N: far above what a strand's
-/// weight and stiffness put on it, so it slips only when the pointer leaves the strand's reach.
+/// Largest force the hand's grab transmits before it slips, N: about what breaks a human hair
+/// (a hair holds about 100 g). Far above what a strand's weight, inertia and stiffness put on
+/// the hand (1e-5 to 1e-3 N), so the grab lets go only of a strand pulled well past its reach.
 pub const HAND_FORCE_LIMIT: Real = 1.0;
+
+/// The hand's virtual coupling (`docs/haptics.md`): the pointer pulls the node it holds
+/// through a spring of 5 N/m and a damper of 1e-3 N·s/m, so a grab slips only on
+/// [`HAND_FORCE_LIMIT`], never on reach.
+///
+/// The pointer is a position source that renders no force, so the sampled-data passivity
+/// bound a device needs (`b > G·K·T/2 + G·B`) does not limit `K` and `B` here; they are chosen
+/// for what the picture shows. Stiffness: the hair's own pull, at most about 1e-3 N while the
+/// strand follows, stretches the spring by 0.2 mm at most, under a pixel at the page's framing:
+/// the node stays under the pointer; a strand pulled taut holds until the pointer is
+/// `HAND_FORCE_LIMIT / K` = 20 cm past its reach, twice what head-2's shaking head (0.5 rad
+/// either way, roots up to 9.3 cm from its axis) moves a root away from a still pointer.
+/// Damping: about critical for one hair node (6.5e-8 kg) on that spring, `2√(K m)` =
+/// 1.1e-3 N·s/m, and a time constant `B/K` of 0.2 ms, a fifth of a 1 ms step: the damper adds
+/// no visible lag to a drag.
+pub const HAND_COUPLING: Coupling = Coupling::new(5.0, 1.0e-3);
 
 /// Where the scene came from.
 #[derive(Clone, Debug)]
@@ -292,18 +309,14 @@ impl Session {
     }
 
     /// Switches the solver and restarts: the rod trades `shape` for `bending` and `twist`,
-    /// DFTL the other way round (and lets go of grabs, which it has not).
+    /// DFTL the other way round; the scene's grabs hold with either.
     ///
     /// # Errors
     /// The scene's checks refuse the switch (the running scene is kept).
     pub fn set_solver(&mut self, solver: Solver) -> Result<(), String> {
         let (name, add, remove): (&str, &[Effect], &[Effect]) = match solver {
             Solver::Rod => ("rod", &[Effect::Bending, Effect::Twist], &[Effect::Shape]),
-            Solver::Dftl => (
-                "dftl",
-                &[Effect::Shape],
-                &[Effect::Bending, Effect::Twist, Effect::Grabs],
-            ),
+            Solver::Dftl => ("dftl", &[Effect::Shape], &[Effect::Bending, Effect::Twist]),
         };
         self.edited(|scene| {
             scene.solver = name.into();
@@ -314,9 +327,6 @@ impl Session {
                 if !scene.effects.iter().any(|e| e == effect.name()) {
                     scene.effects.push(effect.name().into());
                 }
-            }
-            if solver == Solver::Dftl {
-                scene.grabs.clear();
             }
         })?;
         self.reset()
@@ -395,15 +405,13 @@ impl Session {
         Ok(())
     }
 
-    /// Grabs `node` of `strand` where it is (turning `grabs` on).
+    /// Grabs `node` of `strand` where it is, through [`HAND_COUPLING`] (turning `grabs` on).
     ///
     /// # Errors
-    /// DFTL (it has no grab constraint), or a grab the core cannot hold.
+    /// A grab the core cannot hold (no such strand, every grab slot taken).
     pub fn grab(&mut self, strand: usize, node: usize) -> Result<(), String> {
-        if self.prepared.params.solver == Solver::Dftl {
-            return Err("DFTL has no grab constraint: switch to the rod to grab a strand".into());
-        }
-        each!(&mut self.running, s => s.grab(strand, node, HAND_FORCE_LIMIT))?;
+        let limit = HAND_FORCE_LIMIT;
+        each!(&mut self.running, s => s.grab(strand, node, limit, HAND_COUPLING))?;
         self.apply_params()
     }
 
@@ -467,6 +475,7 @@ impl Session {
             "grab_force": force.to_array(),
             "grab_target": target,
             "grab_limit": HAND_FORCE_LIMIT,
+            "grab_coupling": [HAND_COUPLING.stiffness, HAND_COUPLING.damping],
             "held": held.map(|(strand, node, at)| json!({
                 "strand": strand, "node": node, "position": at.to_array(),
             })),

@@ -1,8 +1,8 @@
 //! One running scene at strand capacity `N`: the core's pipeline, on one thread, with the
 //! scene's grabs and the hand's, in the lanes `hairsim run` steps them in (the rod's strands
-//! [`ROD_LANES`] at a time, DFTL's as structure-of-arrays blocks of [`DFTL_LANES`]). The bits
-//! are those of `hairsim run`: every layout of the core gives the state of one
-//! `step_strands` call over all the strands.
+//! [`ROD_LANES`] at a time, DFTL's as structure-of-arrays blocks of [`DFTL_LANES`], a block
+//! holding a grabbed strand strand by strand). The bits are those of `hairsim run`: every
+//! layout of the core gives the state of one `step_strands` call over all the strands.
 
 use hairsim_core::dftl::{collisions, follow_leader, DftlBlock};
 use hairsim_core::grab::MAX_GRABS;
@@ -10,10 +10,10 @@ use hairsim_core::lane::V3;
 use hairsim_core::params::DftlCoefficients;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
-    step_blocks, step_strands_in_lanes_with, Collider, DefaultMath, Grab, GrabStatus, Params, Pose,
-    Real, RodBlockScratch, Shape, Solver, StepReport, Strand, Vec3,
+    step_strands_in_blocks, step_strands_in_lanes_with, Collider, Coupling, DefaultMath, Grab,
+    GrabStatus, Params, Pose, Real, RodBlockScratch, Shape, Solver, StepReport, Strand, Vec3,
 };
-use hairsim_files::lanes::{load_state, VectorSqrt, DFTL_LANES, ROD_LANES};
+use hairsim_files::lanes::{VectorSqrt, DFTL_LANES, ROD_LANES};
 use hairsim_files::scene::start::StepInputs;
 use hairsim_files::scene::{FieldError, Prepared};
 
@@ -22,7 +22,7 @@ use hairsim_files::scene::{FieldError, Prepared};
 type LaneMath = VectorSqrt<DefaultMath>;
 
 /// The strands' lanes: the rod's scratch space, or DFTL's blocks (rest data loaded once, the
-/// state copied in and out every step).
+/// state copied in and out every step by [`step_strands_in_blocks`]).
 #[derive(Debug)]
 enum Lanes<const N: usize> {
     Rod(Box<RodBlockScratch<LaneMath, N, ROD_LANES>>),
@@ -174,13 +174,18 @@ impl<const N: usize> Stepper<N> {
                 step_strands_in_lanes_with(&ctx, &mut self.strands, at, None, scratch, &mut report);
             }
             Lanes::Dftl(blocks) => {
-                for (block, strands) in blocks.iter_mut().zip(self.strands.chunks(DFTL_LANES)) {
-                    load_state(block, strands);
-                }
-                step_blocks::<LaneMath, DFTL_LANES, N>(&ctx, blocks, 0, None, &mut report);
-                for (block, strands) in blocks.iter().zip(self.strands.chunks_mut(DFTL_LANES)) {
-                    block.store(strands);
-                }
+                // A block holding a grabbed strand steps strand by strand (the same bits):
+                // `step_blocks` alone would step a held strand as if nothing held it.
+                let at = (0, self.grabs.as_slice());
+                let strands = &mut self.strands;
+                step_strands_in_blocks::<LaneMath, DFTL_LANES, N>(
+                    &ctx,
+                    blocks,
+                    strands,
+                    at,
+                    None,
+                    &mut report,
+                );
             }
         }
         pipeline::finish(&mut self.grabs, &report);
@@ -281,11 +286,18 @@ impl<const N: usize> Stepper<N> {
     }
 
     /// Grabs node `node` (moved to 2 at least: nodes 0 and 1 are the root's) of `strand` where
-    /// it is, slipping above `force_limit` newtons; lets go of any earlier hand grab.
+    /// it is, through `coupling`, slipping above `force_limit` newtons; lets go of any earlier
+    /// hand grab.
     ///
     /// # Errors
     /// No such strand, or every grab slot taken by the scene's own grabs.
-    pub fn grab(&mut self, strand: usize, node: usize, force_limit: Real) -> Result<(), String> {
+    pub fn grab(
+        &mut self,
+        strand: usize,
+        node: usize,
+        force_limit: Real,
+        coupling: Coupling,
+    ) -> Result<(), String> {
         self.release();
         let Some(s) = self.strands.get(strand) else {
             return Err(format!(
@@ -304,8 +316,8 @@ impl<const N: usize> Stepper<N> {
         }
         let target = s.state.position[node];
         let index = |i: usize| u32::try_from(i).unwrap_or(u32::MAX);
-        self.grabs
-            .push(Grab::new(index(strand), index(node), target, force_limit));
+        let grab = Grab::new(index(strand), index(node), target, force_limit);
+        self.grabs.push(grab.with_coupling(coupling));
         self.hand = Some(Hand {
             grab: self.grabs.len() - 1,
             target,
@@ -335,11 +347,6 @@ impl<const N: usize> Stepper<N> {
                     rest_shape(strand, &self.head);
                 }
                 pulled += 1;
-            }
-        }
-        if let Lanes::Dftl(blocks) = &mut self.lanes {
-            for (block, strands) in blocks.iter_mut().zip(self.strands.chunks(DFTL_LANES)) {
-                load_state(block, strands);
             }
         }
         pulled

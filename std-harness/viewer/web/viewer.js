@@ -173,8 +173,9 @@ function draw() {
   drawHand(frame.camera);
 }
 
-// The hand over the picture (a 2-D overlay): the held node, the force as an arrow, and after
-// a slip the node and the hand joined by a dashed line.
+// The hand over the picture (a 2-D overlay): the held node, the force as an arrow, the
+// coupling's spring as a line from the node to the hand when it stretches, and after a slip
+// the node and the hand joined by a dashed line.
 function drawHand(cam) {
   const overlay = $("overlay");
   if (overlay.width !== view.width || overlay.height !== view.height) {
@@ -207,6 +208,16 @@ function drawHand(cam) {
     ctx.font = "13px system-ui, sans-serif";
     ctx.fillText("slipped: press again to re-grab", x + 10, y - 10);
     return;
+  }
+  // The spring between the hand and the node, drawn once it stretches past a few pixels: a
+  // strand pulled taut, or a node that lags a fast hand.
+  if (Math.hypot(nx - x, ny - y) > 3) {
+    ctx.strokeStyle = "#6cf8";
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    ctx.moveTo(x, y);
+    ctx.lineTo(nx, ny);
+    ctx.stroke();
   }
   const f = s.grab_force;
   const magnitude = Math.hypot(...f);
@@ -318,6 +329,7 @@ function numbers() {
     module: sim.module,
     renderer: renderer.kind,
     warnings: [...state.warnings.values()].map((w) => w.text),
+    plotted: { samples: state.forces.length, max: Math.max(0, ...state.forces.map(([, f]) => f)) },
     slips: state.slips.length,
     stuck: !$("stuck").hidden,
     loaded: state.loaded,
@@ -335,7 +347,8 @@ function showNumbers() {
     `${n.frames_per_s.toFixed(0)} frames/s, ${n.draw_ms_per_frame.toFixed(1)} ms drawing each\n` +
     `${s.strands} strands + ${n.drawn_followers} followers drawn, ${s.nodes} nodes\n` +
     `${sim.module.includes("simd") ? "WebAssembly SIMD" : "WebAssembly (no SIMD)"}, ${renderer.kind}\n` +
-    `grab ${s.grab}`;
+    `grab ${s.grab}` + (s.grab === "held" ? `, ${Math.hypot(...s.grab_force).toExponential(2)} N` : "") +
+    ` (spring ${s.grab_coupling[0]} N/m, slips above ${s.grab_limit} N)`;
   $("hash").textContent = `hash ${n.state_hash}`;
   $("hash-note").textContent = s.hair_hair_dropped
     ? "not the native hash: this scene has hair–hair (SPH), which runs in `hairsim run`, not here"
@@ -595,11 +608,13 @@ window.hairsim = {
   setEffect: (name, on) => act(() => sim.setEffect(name, on)),
   error: () => state.error,
   sceneToml: () => sim.sceneToml(),
-  screen: (strand, node) => {
+  // Where node `node` of strand `strand` is, m, and on the screen (x, y in pixels, depth).
+  node: (strand, node) => {
     const { points, offsets } = sim.positions();
     const n = offsets[strand] + node;
-    return camera().project([points[3 * n], points[3 * n + 1], points[3 * n + 2]]);
+    return [points[3 * n], points[3 * n + 1], points[3 * n + 2]];
   },
+  screen: (strand, node) => camera().project(window.hairsim.node(strand, node)),
   // The stepping cost in µs per step over `steps` steps from the start (the page paused):
   // the median over batches of at least 2 ms each (the page's timer is coarse), after the same
   // steps run once untimed: the browser compiles a module's hot functions a second time,
