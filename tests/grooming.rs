@@ -48,7 +48,11 @@ fn scene_as_written(name: &str) -> Scene {
 /// scene's drag, the head still, 1 s, at `dt`.
 #[must_use]
 pub fn groom_scene(name: &str, solver: &str, dt: Real) -> Prepared {
-    let mut scene = scene_as_written(name);
+    groom_from(scene_as_written(name), name, solver, dt)
+}
+
+/// `scene` (called `name`) as the groom test runs it.
+fn groom_from(mut scene: Scene, name: &str, solver: &str, dt: Real) -> Prepared {
     scene.solver = solver.into();
     let mut effects = vec!["gravity", "drag", "inextensibility", "collisions"];
     effects.extend(if solver == "dftl" {
@@ -123,6 +127,8 @@ pub struct Still {
     pub sag: Real,
     /// The largest relative stretch any step reported.
     pub stretch: Real,
+    /// Nodes a collider pushed out per step, on average over the last 0.5 s.
+    pub contacts: Real,
 }
 
 /// Runs `prepared` still for 1 s.
@@ -132,11 +138,17 @@ pub fn still(prepared: &Prepared, layout: Layout) -> Still {
     let mut sim = simulation(prepared, layout);
     let mut groom: Option<Groom> = None;
     let mut stretch: Real = 0.0;
+    let (mut contacts, mut late_steps) = (0u64, 0u64);
     let steps = steps_for(1.0, dt);
     for k in 0..steps {
         let report = sim.step(&held(Pose::IDENTITY));
         stretch = stretch.max(report.max_stretch);
-        if (k + 1) as Real * dt > 0.5 + 0.5 * dt && sampled(k, dt) {
+        let late = (k + 1) as Real * dt > 0.5 + 0.5 * dt;
+        if late {
+            contacts += u64::from(report.contacts);
+            late_steps += 1;
+        }
+        if late && sampled(k, dt) {
             let now = measure(&sim.strands);
             groom = Some(groom.map_or(now, |g| worse(g, now)));
         }
@@ -147,6 +159,7 @@ pub fn still(prepared: &Prepared, layout: Layout) -> Still {
         rest_turning: groom.rest_mean_turning,
         sag: mean_sag(&sim.strands, prepared.params.gravity),
         stretch,
+        contacts: contacts as Real / late_steps.max(1) as Real,
     }
 }
 
@@ -337,4 +350,151 @@ fn tip_distance(a: &[Strand<CAPACITY>], b: &[Strand<CAPACITY>]) -> Real {
         })
         .sum();
     sum / a.len().max(1) as Real
+}
+
+/// Radius of the generated head the combed groom rests on, m.
+pub const COMBED_HEAD_RADIUS: f64 = 0.09;
+
+/// The generated groom resting on a head sphere of [`COMBED_HEAD_RADIUS`] about the origin:
+/// 300 strands of 40 nodes and 25 cm, rooted 2 mm outside the sphere on a cap of 1.1 rad
+/// about +y (a Fibonacci spiral), combed down the meridians over the sphere, on its surface
+/// from 2 cm on, and hanging straight down past its equator; every other strand wavy (5 mm
+/// across, 5 cm wavelength, the wave in the surface) and the others curly (a helix of 5 mm
+/// radius and 3 cm pitch whose inner side touches the sphere). The rest groom lies on the
+/// sphere and nowhere inside it: gravity alone presses it on.
+#[must_use]
+pub fn combed_strands() -> Vec<Vec<Vec3>> {
+    let leaders = 300;
+    let cap: f64 = 1.1;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    (0..leaders)
+        .map(|k| {
+            let y = 1.0 - (1.0 - cap.cos()) * (k as f64 + 0.5) / leaders as f64;
+            let ring = (1.0 - y * y).max(0.0).sqrt();
+            let phi = golden * k as f64;
+            let normal = [ring * phi.cos(), y, ring * phi.sin()];
+            let dense = combed_centreline(normal, k % 2 == 0);
+            resample(&dense, 40, 0.25)
+        })
+        .collect()
+}
+
+/// A 3-vector in `f64`.
+type D3 = [f64; 3];
+
+fn add(a: D3, b: D3, s: f64) -> D3 {
+    [a[0] + b[0] * s, a[1] + b[1] * s, a[2] + b[2] * s]
+}
+
+fn dot(a: D3, b: D3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: D3) -> D3 {
+    let l = dot(a, a).sqrt();
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+fn cross(a: D3, b: D3) -> D3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// A combed strand rooted at the unit `normal` of the head, as a dense polyline (0.1 mm apart
+/// along the comb, longer than the strand).
+fn combed_centreline(normal: D3, wavy: bool) -> Vec<D3> {
+    let radius = COMBED_HEAD_RADIUS;
+    let (lift, landing) = (0.002, 0.02);
+    // Down the meridian: the unit tangent at the root pointing away from the crown.
+    let down = if normal[1] > 1.0 - 1e-9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        unit(add([0.0, -1.0, 0.0], normal, normal[1]))
+    };
+    // The arc to the equator, where the meridian turns vertical; then straight down.
+    let to_equator = radius * (std::f64::consts::FRAC_PI_2 - normal[1].clamp(-1.0, 1.0).acos());
+    (0..4000)
+        .map(|j| {
+            let s = 1e-4 * f64::from(j);
+            let angle = s.min(to_equator) / radius;
+            let out = add(normal.map(|v| v * angle.cos()), down, angle.sin());
+            let along = add(down.map(|v| v * angle.cos()), normal, -angle.sin());
+            let side = cross(along, out);
+            let height = radius + lift * (1.0 - s / landing).max(0.0).powi(2);
+            let on = add(out.map(|v| v * height), [0.0, -1.0, 0.0], (s - to_equator).max(0.0));
+            if wavy {
+                let across = 0.005 * (std::f64::consts::TAU * s / 0.05).sin();
+                let p = add(on, side, across);
+                // On the sphere, the wave stays on its surface (at the lifted root's height).
+                if s < to_equator {
+                    unit(p).map(|v| v * height)
+                } else {
+                    p
+                }
+            } else {
+                let (helix, pitch) = (0.005, 0.03);
+                let turn = std::f64::consts::TAU * s / pitch;
+                let p = add(on, out, helix * (1.0 - turn.cos()));
+                add(p, side, helix * turn.sin())
+            }
+        })
+        .collect()
+}
+
+/// `nodes` points equally spaced by arc length along the first `length` of `dense`.
+fn resample(dense: &[D3], nodes: usize, length: f64) -> Vec<Vec3> {
+    let mut arc = vec![0.0];
+    for w in dense.windows(2) {
+        let d = add(w[1], w[0], -1.0);
+        arc.push(arc[arc.len() - 1] + dot(d, d).sqrt());
+    }
+    let mut j = 0;
+    (0..nodes)
+        .map(|i| {
+            let s = length * i as f64 / (nodes - 1) as f64;
+            while arc[j + 1] < s {
+                j += 1;
+            }
+            let f = (s - arc[j]) / (arc[j + 1] - arc[j]);
+            let p = add(dense[j], add(dense[j + 1], dense[j], -1.0), f);
+            Vec3::new(p[0] as Real, p[1] as Real, p[2] as Real)
+        })
+        .collect()
+}
+
+/// The resting grooms: a sample file in `hairsim run`'s default scene, whose head sphere
+/// touches its scalp, and the generated [`combed_strands`].
+pub const RESTING: [&str; 2] = ["sintel-on-head", "combed"];
+
+/// The resting groom `name` as [`groom_scene`] runs a groom (DFTL + shape + gravity +
+/// collisions, drag, the head still, 1 s at `dt`), its head sphere `shrink` m smaller.
+#[must_use]
+pub fn resting_scene(name: &str, dt: Real, shrink: Real) -> Prepared {
+    let mut scene = match name {
+        "sintel-on-head" => scene_as_written("sintel"),
+        "combed" => {
+            // head-3 (a 10 cm sphere, DFTL's default shape) with the combed strands.
+            let mut scene = scene_as_written("head-3");
+            scene.hair = None;
+            scene.strands = combed_strands()
+                .into_iter()
+                .map(|points| hairsim::scene::StrandSpec {
+                    points: Some(points.iter().map(|p| p.to_array()).collect()),
+                    ..Default::default()
+                })
+                .collect();
+            scene.colliders[0].radius = Some(COMBED_HEAD_RADIUS as Real);
+            scene
+        }
+        other => panic!("{other}: not a resting groom"),
+    };
+    for collider in &mut scene.colliders {
+        if let Some(r) = collider.radius.as_mut() {
+            *r -= shrink;
+        }
+    }
+    groom_from(scene, name, "dftl", dt)
 }

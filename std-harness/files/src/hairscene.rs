@@ -1,7 +1,7 @@
 //! The default scene around a hair file (`hairsim run head.hair`): DFTL with shape
 //! preservation at 1 ms, gravity, drag and inextensibility, the head still, and a head sphere
-//! fitted to the strands' roots (with collisions on) when the roots outline one, just inside
-//! the roots and every other point of the groom.
+//! fitted to the strands' roots (with collisions on) when the roots outline one, touching the
+//! scalp at its lowest held node.
 //!
 //! Why DFTL and not the rod: real hair files hold tight curls and short, uneven segments, which
 //! put an explicit rod far past its stability limit at 1 ms; DFTL is stable for any shape at a
@@ -66,35 +66,45 @@ pub fn scene_for_hair_file_in(
         .filter_map(|s| s.first().copied())
         .collect();
     let mut options = options.clone();
-    let mut scale = 1.0;
     if options.scale.is_none() {
-        scale = automatic_scale(&roots, &model.strands);
+        let scale = automatic_scale(&roots, &model.strands);
         roots.iter_mut().for_each(|r| *r *= scale);
         options.scale = Some(scale);
     }
     let mut scene = scene_around(path, &options, &roots);
-    clear_the_groom(&mut scene, &model.strands, scale);
+    // The strands as the run will build them (in metres, and picked from those the scale
+    // keeps longer than `min_length`).
+    if let Some(HairSpec::File(file)) = &scene.hair {
+        let strands = crate::scene::prepare::read_hair_file(file, files)?.strands;
+        touch_the_scalp(&mut scene, &strands);
+    }
     Ok(scene)
 }
 
-/// Shrinks the fitted head sphere of `scene` until no point of `strands` (times `scale`) is
-/// inside it, with a 1 % margin: a groom that starts inside its collider is pushed out at
-/// the first step, a jolt of several metres per second at 1 ms that deforms the groom before
-/// anything moves (sintel_hair.tfx had 67 of 5,016 simulated nodes inside, up to 7 mm deep;
-/// Ratboy_mohawk.tfx 1,474 of 21,626).
-fn clear_the_groom(scene: &mut Scene, strands: &[Vec<Vec3>], scale: f32) {
+/// The share of its distance from the centre by which the fitted head stays below the lowest
+/// held node: 0.1 %, 0.09 mm on a 9 cm head.
+const SCALP_CLEARANCE: f32 = 1e-3;
+
+/// Brings the fitted head sphere of `scene` down from just inside the roots to the lowest held
+/// node (0.1 % below it): nodes 0 and 1 of every strand of `strands`, which
+/// the head carries and no collision moves. A head sphere above a held node would grow the
+/// strand out of the head, its node 2 pushed out beside its node 1 at every step, a kink at
+/// the root. So the sphere touches the scalp where it is lowest; the rest of the groom may dip
+/// into it (a real scalp is no sphere), and those nodes start outside it, each at its length
+/// from the one before (`Prepared::start_strands`), and rest pressed onto it.
+fn touch_the_scalp(scene: &mut Scene, strands: &[Vec<Vec3>]) {
     for collider in &mut scene.colliders {
         let (Some(centre), Some(radius)) = (collider.centre, collider.radius.as_mut()) else {
             continue;
         };
         let centre = Vec3::from_array(centre);
-        let nearest = strands
+        let lowest = strands
             .iter()
-            .flatten()
-            .map(|p| (*p * scale - centre).length())
+            .flat_map(|s| s.iter().take(2))
+            .map(|p| (*p - centre).length())
             .filter(|d| d.is_finite())
             .fold(f32::INFINITY, f32::min);
-        *radius = radius.min(nearest * 0.99);
+        *radius = radius.min(lowest * (1.0 - SCALP_CLEARANCE));
     }
 }
 
