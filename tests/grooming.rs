@@ -424,7 +424,11 @@ fn combed_centreline(normal: D3, wavy: bool) -> Vec<D3> {
             let along = add(down.map(|v| v * angle.cos()), normal, -angle.sin());
             let side = cross(along, out);
             let height = radius + lift * (1.0 - s / landing).max(0.0).powi(2);
-            let on = add(out.map(|v| v * height), [0.0, -1.0, 0.0], (s - to_equator).max(0.0));
+            let on = add(
+                out.map(|v| v * height),
+                [0.0, -1.0, 0.0],
+                (s - to_equator).max(0.0),
+            );
             if wavy {
                 let across = 0.005 * (std::f64::consts::TAU * s / 0.05).sin();
                 let p = add(on, side, across);

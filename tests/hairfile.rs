@@ -732,7 +732,10 @@ fn real_samples_run_in_their_default_scene() {
                 );
                 let distance = |p: &Vec3| (*p - centre).length();
                 let prepared = &loaded.prepared;
-                let held = prepared.strands.iter().flat_map(|s| s.points.iter().take(2));
+                let held = prepared
+                    .strands
+                    .iter()
+                    .flat_map(|s| s.points.iter().take(2));
                 let lowest = held.map(distance).fold(f32::INFINITY, f32::min);
                 assert!(
                     lowest >= radius && lowest < radius * 1.0011,

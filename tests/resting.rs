@@ -78,13 +78,19 @@ fn rests_on_the_head(name: &str) {
             s.stretch.max(k.stretch),
             start.elapsed().as_secs_f32(),
         );
-        assert!(free.contacts == 0.0, "{name} at {dt}: the shrunk head touched");
+        assert!(
+            free.contacts == 0.0,
+            "{name} at {dt}: the shrunk head touched"
+        );
         if name == "combed" {
             assert!(s.contacts >= 0.1 * nodes, "{name} at {dt}: not resting");
         }
         for (groom, what) in [(s.groom, "still"), (k.groom_after, "after the shake")] {
             assert!(groom.kinked < 0.01, "{name} at {dt}: kinked {what}");
-            assert!(groom.mean_turning <= turning, "{name} at {dt}: turning {what}");
+            assert!(
+                groom.mean_turning <= turning,
+                "{name} at {dt}: turning {what}"
+            );
         }
         assert!(k.speed_excess < 1.0, "{name} at {dt}: flutter");
         assert!(s.stretch.max(k.stretch) <= 1e-5, "{name} at {dt}: stretch");
@@ -106,4 +112,3 @@ fn the_sample_rests_on_its_head() {
 fn the_combed_groom_rests_on_its_head() {
     rests_on_the_head(RESTING[1]);
 }
-

@@ -256,16 +256,15 @@ fn from_world<const S: usize, const N: usize, M: Math>(
     scene.gravity = Some(params.gravity.to_array());
     scene.drag = Some(params.drag);
     scene.head = Some(ten_rad_per_s());
-    if params.solver == hairsim_core::Solver::Rod {
-        let r = params.rod;
-        scene.rod = Some(crate::scene::RodSpec {
-            twist: Some(r.twist.name().into()),
-            projection_iterations: Some(u32::from(r.projection_iterations)),
-            projection_tolerance: Some(r.projection_tolerance),
-            newton_iterations: Some(u32::from(r.newton_iterations)),
-            newton_tolerance: Some(r.newton_tolerance),
-        });
-    }
+    // With either solver: DFTL's held strands take the rod's projection, with its caps.
+    let r = params.rod;
+    scene.rod = Some(crate::scene::RodSpec {
+        twist: Some(r.twist.name().into()),
+        projection_iterations: Some(u32::from(r.projection_iterations)),
+        projection_tolerance: Some(r.projection_tolerance),
+        newton_iterations: Some(u32::from(r.newton_iterations)),
+        newton_tolerance: Some(r.newton_tolerance),
+    });
     if params.solver == hairsim_core::Solver::Dftl {
         let d = params.dftl;
         scene.dftl = Some(crate::scene::DftlSpec {

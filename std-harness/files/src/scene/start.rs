@@ -233,7 +233,10 @@ nodes = 11
         assert!(inside_at_rest >= 4, "{inside_at_rest}");
         for i in 0..11 {
             let x = through.state.position[i];
-            assert!((x - centre).length() >= radius * (1.0 - 1e-6), "node {i}: {x}");
+            assert!(
+                (x - centre).length() >= radius * (1.0 - 1e-6),
+                "node {i}: {x}"
+            );
             if i > 0 {
                 let length = (x - through.state.position[i - 1]).length();
                 let expected = rest.segment_length[i - 1];
