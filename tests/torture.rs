@@ -237,15 +237,16 @@ impl Case {
         if let (Shape::Sphere { centre, radius }, false) = (shape, attached) {
             self.spheres.push((centre, radius));
         }
+        // Collisions first: a world refuses a collider while they are off.
+        let mut p = *self.world.params();
+        p.effects = p.effects.with(Effect::Collisions);
+        self.world.configure(p).unwrap();
         self.world
             .add_collider(Collider {
                 shape,
                 attached_to_head: attached,
             })
             .unwrap();
-        let mut p = *self.world.params();
-        p.effects = p.effects.with(Effect::Collisions);
-        self.world.configure(p).unwrap();
         self
     }
 

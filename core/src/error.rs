@@ -129,6 +129,14 @@ pub enum ParamError {
         /// The solver's name.
         solver: &'static str,
     },
+    /// Something was added that only an effect that is off would use: a collider without
+    /// `collisions`, a grab without `grabs`.
+    EffectOff {
+        /// The effect's name.
+        effect: &'static str,
+        /// What was added ("a collider", "a grab").
+        item: &'static str,
+    },
 }
 
 impl fmt::Display for ParamError {
@@ -140,6 +148,10 @@ impl fmt::Display for ParamError {
             ParamError::UnsupportedEffect { effect, solver } => write!(
                 f,
                 "the {solver} solver cannot simulate the effect \"{effect}\""
+            ),
+            ParamError::EffectOff { effect, item } => write!(
+                f,
+                "{item} needs the effect \"{effect}\", which is off: turn it on before adding one"
             ),
         }
     }

@@ -47,6 +47,7 @@ pub mod root_coupling;
 pub mod scenes;
 pub mod snapshot;
 pub mod strand;
+pub mod stretch;
 pub mod wind;
 pub mod world;
 

@@ -229,15 +229,29 @@ fn range(ok: bool, field: &'static str, allowed: &'static str) -> Result<(), Par
 /// The least `s_d` DFTL accepts with the local shape constraint on ([`Params::validate`]).
 pub const MIN_SHAPE_DAMPING: Real = 0.5;
 
+/// Air drag per node of the presets, kg/s: what the built-in scenes and the scene files in
+/// `scenes/` use for human hair at 1 cm segments.
+pub const PRESET_DRAG: Real = 2.0e-7;
+
 impl Params {
-    /// Rod, 1 ms, gravity only, converge mode.
-    pub const DEFAULT: Params = Params {
+    /// The rod's preset (Kmoch 2009): gravity, air drag ([`PRESET_DRAG`]), bending, twist
+    /// (hair-optimised, Sec. 6.2) and inextensibility (the fast manifold projection, capped at
+    /// 8 iterations, tolerance 1e-6), at 1 ms in converge mode. No collisions and no grabs: a
+    /// scene turns them on when it adds colliders or grabs (adding one while its effect is off
+    /// is refused, [`crate::World::add_collider`]).
+    pub const ROD: Params = Params {
         solver: Solver::Rod,
         dt: 0.001,
-        effects: Effects::NONE.with(Effect::Gravity),
+        effects: Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Drag,
+            Effect::Bending,
+            Effect::Twist,
+            Effect::Inextensibility,
+        ]),
         mode: Mode::Converge,
         gravity: Vec3::new(0.0, -9.81, 0.0),
-        drag: 0.0,
+        drag: PRESET_DRAG,
         rod: RodParams {
             projection_iterations: 8,
             projection_tolerance: 1.0e-6,
@@ -263,6 +277,34 @@ impl Params {
             seed: 0x5EED,
         },
     };
+
+    /// DFTL's preset (Sánchez-Banderas 2015): gravity, air drag ([`PRESET_DRAG`]),
+    /// inextensibility (follow-the-leader) and shape preservation (the paper's `s_g` = 0.1 and
+    /// `s_l` = 0.3 at 16 ms, carried to 1 ms; `s_d` = 0.9), at 1 ms. No collisions and no grabs,
+    /// as [`Params::ROD`].
+    pub const DFTL: Params = Params {
+        solver: Solver::Dftl,
+        effects: Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Drag,
+            Effect::Inextensibility,
+            Effect::Shape,
+        ]),
+        ..Params::ROD
+    };
+
+    /// The rod's preset, [`Params::ROD`]: what `World::new` starts from.
+    pub const DEFAULT: Params = Params::ROD;
+
+    /// The preset of `solver`: the effects and values hair needs ([`Params::ROD`],
+    /// [`Params::DFTL`]). Start from it and change what the scene needs.
+    #[must_use]
+    pub const fn preset(solver: Solver) -> Params {
+        match solver {
+            Solver::Rod => Params::ROD,
+            Solver::Dftl => Params::DFTL,
+        }
+    }
 
     /// Checks every parameter against its range and the effects against the solver (the
     /// first failure, in this order: time step, forces, rod, DFTL, wind, effects).
@@ -434,6 +476,32 @@ mod tests {
     use super::*;
 
     #[test]
+    fn presets_are_hair() {
+        let rod = Params::preset(Solver::Rod);
+        let dftl = Params::preset(Solver::Dftl);
+        assert_eq!((rod, dftl), (Params::ROD, Params::DFTL));
+        assert_eq!(Params::DEFAULT, Params::ROD);
+        let names = |p: &Params| {
+            p.effects
+                .iter()
+                .map(Effect::name)
+                .collect::<heapless::Vec<_, 10>>()
+        };
+        assert_eq!(
+            names(&rod),
+            ["gravity", "drag", "bending", "twist", "inextensibility"]
+        );
+        assert_eq!(
+            names(&dftl),
+            ["gravity", "drag", "inextensibility", "shape"]
+        );
+        for preset in [rod, dftl] {
+            assert_eq!(preset.validate(), Ok(()));
+            assert!(preset.drag > 0.0 && preset.gravity.y < 0.0 && preset.dt == 0.001);
+        }
+    }
+
+    #[test]
     fn defaults_are_valid_and_ranges_are_named() {
         assert_eq!(Params::DEFAULT.validate(), Ok(()));
         let bad = Params {
@@ -447,10 +515,7 @@ mod tests {
                 allowed: "1e-5 s to 0.02 s"
             })
         );
-        let dftl = Params {
-            solver: Solver::Dftl,
-            ..Params::DEFAULT
-        };
+        let dftl = Params::DFTL;
         assert_eq!(dftl.validate(), Ok(()));
         let sideways = Params {
             wind: WindParams {
@@ -486,10 +551,7 @@ mod tests {
 
     #[test]
     fn dftl_takes_grabs_and_refuses_the_rod_s_energies() {
-        let dftl = Params {
-            solver: Solver::Dftl,
-            ..Params::DEFAULT
-        };
+        let dftl = Params::DFTL;
         let grabs_on_dftl = Params {
             effects: Effects::NONE.with(Effect::Grabs),
             ..dftl

@@ -63,6 +63,9 @@ pub const STAGE_COUNT: usize = 12;
 
 pub use crate::capacities::NAMED_STRANDS;
 
+/// The relative stretch above which a step raises [`Flags::STRETCHED`].
+pub const STRETCH_LIMIT: Real = 0.01;
+
 /// Flags raised by a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -85,6 +88,15 @@ impl Flags {
     /// A node was inside more colliders than it can carry collision rows for
     /// (`projection::constraints::MAX_NODE_CONTACTS`); the extra contacts waited an iteration.
     pub const CONTACTS_TRUNCATED: Flags = Flags(32);
+    /// A segment ended the step more than [`STRETCH_LIMIT`] (1 %) longer or shorter than its
+    /// rest length (`max_stretch` or `max_contact_stretch`): inextensibility is off, or
+    /// contacts or grabs pull harder than the projection holds.
+    pub const STRETCHED: Flags = Flags(64);
+    /// The world holds colliders but the `collisions` effect is off: they did nothing.
+    pub const COLLIDERS_INACTIVE: Flags = Flags(128);
+    /// The world holds grabs that hold their node but the `grabs` effect is off: they did
+    /// nothing.
+    pub const GRABS_INACTIVE: Flags = Flags(256);
 
     /// Whether every flag of `other` is set.
     #[must_use]

@@ -6,6 +6,7 @@ use core::marker::PhantomData;
 
 use crate::capacities::{MAX_COLLIDERS, MAX_GRABS};
 use crate::collide::Collider;
+use crate::effects::Effect;
 use crate::error::{CapacityError, Error, ParamError};
 use crate::grab::{retarget, Grab, GrabStatus};
 use crate::head::Pose;
@@ -55,7 +56,8 @@ impl<const S: usize, const N: usize, M: Math> Default for World<S, N, M> {
 }
 
 impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
-    /// An empty world with [`Params::DEFAULT`]: usable to initialise a `static`.
+    /// An empty world with [`Params::DEFAULT`] (the rod's preset): usable to initialise a
+    /// `static`.
     #[must_use]
     pub const fn new() -> Self {
         World {
@@ -101,8 +103,24 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         Ok(self.strands.len() - 1)
     }
 
-    /// Adds a collider; returns its index.
+    /// `Ok` if `effect` is on, else the error saying that `item` needs it.
+    fn needs(&self, effect: Effect, item: &'static str) -> Result<(), Error> {
+        if self.params.effects.contains(effect) {
+            Ok(())
+        } else {
+            Err(ParamError::EffectOff {
+                effect: effect.name(),
+                item,
+            }
+            .into())
+        }
+    }
+
+    /// Adds a collider; returns its index. Refused while the `collisions` effect is off: a
+    /// collider would do nothing. (Turning `collisions` off later keeps the colliders, and each
+    /// step reports them inactive, [`crate::report::Flags::COLLIDERS_INACTIVE`].)
     pub fn add_collider(&mut self, collider: Collider) -> Result<usize, Error> {
+        self.needs(Effect::Collisions, "a collider")?;
         if !collider.shape.is_valid() {
             return Err(ParamError::OutOfRange {
                 field: "collider",
@@ -118,8 +136,11 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         Ok(self.colliders.len() - 1)
     }
 
-    /// Adds a grab; returns its index.
+    /// Adds a grab; returns its index. Refused while the `grabs` effect is off, as
+    /// [`World::add_collider`] (a step reports grabs held with `grabs` off,
+    /// [`crate::report::Flags::GRABS_INACTIVE`]).
     pub fn add_grab(&mut self, grab: Grab) -> Result<usize, Error> {
+        self.needs(Effect::Grabs, "a grab")?;
         let strand = self.strands.get(grab.strand as usize);
         let node_ok = strand.is_some_and(|s| grab.node >= 2 && (grab.node as usize) < s.nodes());
         if !node_ok
@@ -241,7 +262,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             scratch,
             &mut report,
         );
-        finish(&mut self.grabs, &report);
+        finish(&mut self.grabs, &mut report);
         self.head = ctx.head;
         self.steps += 1;
         report
@@ -288,6 +309,51 @@ mod tests {
             "{}",
             s.state.position[5].y
         );
+    }
+
+    #[test]
+    fn a_collider_or_grab_whose_effect_is_off_is_refused_by_name() {
+        let mut w = world();
+        let sphere = Collider {
+            shape: crate::collide::Shape::Sphere {
+                centre: Vec3::new(0.0, -1.0, 0.0),
+                radius: 0.05,
+            },
+            attached_to_head: false,
+        };
+        let grab = Grab::new(0, 3, Vec3::new(0.03, 0.0, 0.0), 1.0);
+        let refused = |effect, item| Err(Error::Param(ParamError::EffectOff { effect, item }));
+        assert_eq!(w.add_collider(sphere), refused("collisions", "a collider"));
+        assert_eq!(w.add_grab(grab), refused("grabs", "a grab"));
+        assert_eq!(
+            std::string::ToString::to_string(&w.add_collider(sphere).unwrap_err()),
+            "a collider needs the effect \"collisions\", which is off: turn it on before adding one"
+        );
+        let on = w
+            .params()
+            .effects
+            .with(Effect::Collisions)
+            .with(Effect::Grabs);
+        let params = Params {
+            effects: on,
+            ..*w.params()
+        };
+        w.configure(params).unwrap();
+        assert_eq!((w.add_collider(sphere), w.add_grab(grab)), (Ok(0), Ok(0)));
+        let still = StepInput {
+            head: Pose::IDENTITY,
+            accelerations: None,
+        };
+        let inactive = Flags::COLLIDERS_INACTIVE;
+        assert!(!w.step(&still).flags.contains(inactive));
+        // Switched off on purpose, both stay and the report says they did nothing.
+        w.configure(Params {
+            effects: on.without(Effect::Collisions).without(Effect::Grabs),
+            ..params
+        })
+        .unwrap();
+        let flags = w.step(&still).flags;
+        assert!(flags.contains(inactive) && flags.contains(Flags::GRABS_INACTIVE));
     }
 
     #[test]

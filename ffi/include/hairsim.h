@@ -66,7 +66,7 @@
 /**
  * The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
  */
-#define HAIRSIM_VERSION_MINOR 3
+#define HAIRSIM_VERSION_MINOR 4
 
 /**
  * The library's patch version: changes that no header sees (fixes, speed).
@@ -180,6 +180,24 @@
 #define HAIRSIM_FLAG_CONTACTS_TRUNCATED (1 << 5)
 
 /**
+ * A segment ended the step more than 1 % longer or shorter than its rest length
+ * (`max_stretch` or `max_contact_stretch` above 0.01): inextensibility is off, or contacts
+ * or grabs pull harder than the constraints hold.
+ */
+#define HAIRSIM_FLAG_STRETCHED (1 << 6)
+
+/**
+ * The world holds colliders but `HAIRSIM_EFFECT_COLLISIONS` is off: they did nothing.
+ */
+#define HAIRSIM_FLAG_COLLIDERS_INACTIVE (1 << 7)
+
+/**
+ * The world holds grabs that hold their node but `HAIRSIM_EFFECT_GRABS` is off: they did
+ * nothing.
+ */
+#define HAIRSIM_FLAG_GRABS_INACTIVE (1 << 8)
+
+/**
  * What every function returns: `HAIRSIM_ERROR_OK` (0) or why it refused. A refused call
  * changes nothing. `hairsim_error_message(code)` says it in words.
  */
@@ -283,6 +301,11 @@ enum hairsim_error
    * `hairsim_init`: the header's `HAIRSIM_NODES` is not the library's.
    */
   HAIRSIM_ERROR_NODES_MISMATCH = 22,
+  /**
+   * A collider was added while `HAIRSIM_EFFECT_COLLISIONS` is off, or a grab while
+   * `HAIRSIM_EFFECT_GRABS` is off: it would do nothing. Turn the effect on first.
+   */
+  HAIRSIM_ERROR_EFFECT_OFF = 23,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -454,7 +477,7 @@ typedef struct hairsim_vec3 {
 } hairsim_vec3;
 
 /**
- * A world's parameters and effects. Start from `hairsim_params_default` and change fields.
+ * A world's parameters and effects. Start from `hairsim_params_preset` and change fields.
  */
 typedef struct hairsim_params {
   /**
@@ -908,8 +931,23 @@ hairsim_error hairsim_init_versioned(struct hairsim_world *buffer,
                                      uint32_t nodes);
 
 /**
- * Fills `out` with the core's default parameters: rod solver, 1 ms, gravity only, converge
- * mode.
+ * Fills `out` with the preset of `solver` (a `hairsim_solver`): the effects and values hair
+ * needs, at 1 ms in converge mode. The rod (`HAIRSIM_SOLVER_ROD`, Kmoch 2009): gravity, air
+ * drag 2e-7 kg/s per node, bending, twist (hair-optimised) and inextensibility (projection
+ * capped at 8 iterations, tolerance 1e-6). DFTL (`HAIRSIM_SOLVER_DFTL`, Sanchez-Banderas
+ * 2015): gravity, the same drag, inextensibility and shape preservation (s_g 0.0066, s_l
+ * 0.022 a millisecond, s_d 0.9). Neither has collisions or grabs: turn
+ * `HAIRSIM_EFFECT_COLLISIONS` or `HAIRSIM_EFFECT_GRABS` on before adding a collider or a grab.
+ * An unknown solver is `HAIRSIM_ERROR_OUT_OF_RANGE`.
+ *
+ * # Safety
+ * `out`, if not NULL, must be valid for writes of a `hairsim_params`.
+ */
+hairsim_error hairsim_params_preset(uint32_t solver, struct hairsim_params *out);
+
+/**
+ * Fills `out` with the rod's preset: `hairsim_params_preset(HAIRSIM_SOLVER_ROD, out)`, the
+ * parameters `hairsim_init` gives a world.
  *
  * # Safety
  * `out`, if not NULL, must be valid for writes of a `hairsim_params`.

@@ -24,13 +24,16 @@ const EFFECTS: [(u32, Effect); 10] = [
 ];
 
 /// The flag bits and the core's flags, one to one.
-const FLAGS: [(u32, Flags); 6] = [
+const FLAGS: [(u32, Flags); 9] = [
     (HAIRSIM_FLAG_CAP_HIT, Flags::CAP_HIT),
     (HAIRSIM_FLAG_ROLLED_BACK, Flags::ROLLED_BACK),
     (HAIRSIM_FLAG_GRAB_SLIPPED, Flags::GRAB_SLIPPED),
     (HAIRSIM_FLAG_BAD_INPUT, Flags::BAD_INPUT),
     (HAIRSIM_FLAG_SINGULAR, Flags::SINGULAR),
     (HAIRSIM_FLAG_CONTACTS_TRUNCATED, Flags::CONTACTS_TRUNCATED),
+    (HAIRSIM_FLAG_STRETCHED, Flags::STRETCHED),
+    (HAIRSIM_FLAG_COLLIDERS_INACTIVE, Flags::COLLIDERS_INACTIVE),
+    (HAIRSIM_FLAG_GRABS_INACTIVE, Flags::GRABS_INACTIVE),
 ];
 
 /// Largest `| |q|^2 - 1 |` a head rotation may have.
@@ -206,11 +209,7 @@ pub(crate) fn params(p: &hairsim_params) -> Result<Params> {
         p.wind_gust_frequency,
     ])?;
     let mut params = Params::DEFAULT;
-    params.solver = match p.solver {
-        x if x == hairsim_solver::Rod as u32 => Solver::Rod,
-        x if x == hairsim_solver::Dftl as u32 => Solver::Dftl,
-        _ => return Err(hairsim_error::OutOfRange),
-    };
+    params.solver = solver(p.solver)?;
     params.mode = match p.mode {
         x if x == hairsim_mode::Converge as u32 => Mode::Converge,
         x if x == hairsim_mode::FixedCost as u32 => Mode::FixedCost,
@@ -245,6 +244,15 @@ pub(crate) fn params(p: &hairsim_params) -> Result<Params> {
     params.wind.gust_frequency = p.wind_gust_frequency;
     params.wind.seed = p.wind_seed;
     Ok(params)
+}
+
+/// The solver a `hairsim_solver` value names.
+pub(crate) fn solver(code: u32) -> Result<Solver> {
+    match code {
+        x if x == hairsim_solver::Rod as u32 => Ok(Solver::Rod),
+        x if x == hairsim_solver::Dftl as u32 => Ok(Solver::Dftl),
+        _ => Err(hairsim_error::OutOfRange),
+    }
 }
 
 pub(crate) fn params_to_c(p: &Params) -> hairsim_params {
@@ -345,6 +353,7 @@ pub(crate) fn param_error(e: ParamError) -> hairsim_error {
     match e {
         ParamError::OutOfRange { .. } => hairsim_error::OutOfRange,
         ParamError::UnsupportedEffect { .. } => hairsim_error::UnsupportedEffect,
+        ParamError::EffectOff { .. } => hairsim_error::EffectOff,
     }
 }
 
@@ -353,6 +362,7 @@ pub(crate) fn add_error(e: Error, invalid: hairsim_error) -> hairsim_error {
     match e {
         Error::Build(e) => build_error(e),
         Error::Capacity(e) => capacity_error(e),
+        Error::Param(e @ ParamError::EffectOff { .. }) => param_error(e),
         Error::Param(_) => invalid,
     }
 }

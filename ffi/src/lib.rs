@@ -367,8 +367,32 @@ unsafe fn init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
     hairsim_error::Ok
 }
 
-/// Fills `out` with the core's default parameters: rod solver, 1 ms, gravity only, converge
-/// mode.
+/// Fills `out` with the preset of `solver` (a `hairsim_solver`): the effects and values hair
+/// needs, at 1 ms in converge mode. The rod (`HAIRSIM_SOLVER_ROD`, Kmoch 2009): gravity, air
+/// drag 2e-7 kg/s per node, bending, twist (hair-optimised) and inextensibility (projection
+/// capped at 8 iterations, tolerance 1e-6). DFTL (`HAIRSIM_SOLVER_DFTL`, Sanchez-Banderas
+/// 2015): gravity, the same drag, inextensibility and shape preservation (s_g 0.0066, s_l
+/// 0.022 a millisecond, s_d 0.9). Neither has collisions or grabs: turn
+/// `HAIRSIM_EFFECT_COLLISIONS` or `HAIRSIM_EFFECT_GRABS` on before adding a collider or a grab.
+/// An unknown solver is `HAIRSIM_ERROR_OUT_OF_RANGE`.
+///
+/// # Safety
+/// `out`, if not NULL, must be valid for writes of a `hairsim_params`.
+#[no_mangle]
+pub unsafe extern "C" fn hairsim_params_preset(
+    solver: u32,
+    out: *mut hairsim_params,
+) -> hairsim_error {
+    let preset = match convert::solver(solver) {
+        Ok(solver) => Params::preset(solver),
+        Err(e) => return e,
+    };
+    // SAFETY: the caller's promise.
+    code(unsafe { write(out, convert::params_to_c(&preset)) })
+}
+
+/// Fills `out` with the rod's preset: `hairsim_params_preset(HAIRSIM_SOLVER_ROD, out)`, the
+/// parameters `hairsim_init` gives a world.
 ///
 /// # Safety
 /// `out`, if not NULL, must be valid for writes of a `hairsim_params`.
@@ -888,6 +912,7 @@ pub extern "C" fn hairsim_error_message(code: i32) -> *const c_char {
         20 => c"hairsim.h is of another version than the library (HAIRSIM_VERSION_MAJOR, MINOR)",
         21 => c"hairsim.h was generated for another HAIRSIM_STRANDS than the library",
         22 => c"hairsim.h was generated for another HAIRSIM_NODES than the library",
+        23 => c"a collider needs HAIRSIM_EFFECT_COLLISIONS on, a grab HAIRSIM_EFFECT_GRABS",
         _ => c"unknown error code",
     };
     message.as_ptr()

@@ -185,6 +185,109 @@ fn init_refuses_a_header_of_another_version_or_capacity() {
 }
 
 #[test]
+fn presets_are_hair_and_effects_that_are_off_refuse_what_needs_them() {
+    let preset = |solver: u32| {
+        let mut p = hairsim_params::default();
+        (unsafe { hairsim_params_preset(solver, &mut p) }, p)
+    };
+    let (code, rod) = preset(hairsim_solver::Rod as u32);
+    assert_eq!(code, E::Ok);
+    let rod_effects = HAIRSIM_EFFECT_GRAVITY
+        | HAIRSIM_EFFECT_DRAG
+        | HAIRSIM_EFFECT_BENDING
+        | HAIRSIM_EFFECT_TWIST
+        | HAIRSIM_EFFECT_INEXTENSIBILITY;
+    assert_eq!(
+        (rod.effects, rod.solver),
+        (rod_effects, hairsim_solver::Rod as u32)
+    );
+    assert!(rod.drag > 0.0 && rod.gravity.y < 0.0);
+    let mut default = hairsim_params::default();
+    assert_eq!(unsafe { hairsim_params_default(&mut default) }, E::Ok);
+    assert_eq!(default, rod);
+    let (code, dftl) = preset(hairsim_solver::Dftl as u32);
+    assert_eq!(code, E::Ok);
+    let dftl_effects = HAIRSIM_EFFECT_GRAVITY
+        | HAIRSIM_EFFECT_DRAG
+        | HAIRSIM_EFFECT_INEXTENSIBILITY
+        | HAIRSIM_EFFECT_SHAPE;
+    assert_eq!(
+        (dftl.effects, dftl.solver),
+        (dftl_effects, hairsim_solver::Dftl as u32)
+    );
+    assert_eq!(preset(2).0, E::OutOfRange);
+
+    let scene = Scene::firmware();
+    let mut storage = Storage::new();
+    let world = storage.init();
+    let (mut collider, grab) = (scene.colliders[0], scene.grabs[0]);
+    // Away from the strand: holding the grab takes no fight with a contact.
+    collider.a.y -= 1.0;
+    // 16 cm across, rooted at the origin: gravity pulls it long without inextensibility.
+    let points: Vec<hairsim_vec3> = (0..NODES)
+        .map(|i| hairsim_vec3 {
+            x: 0.16 * i as f32 / (NODES - 1) as f32,
+            ..Default::default()
+        })
+        .collect();
+    let material = scene.material;
+    let flags_of_steps = |world, steps: u32| {
+        let mut flags = 0;
+        for _ in 0..steps {
+            let mut report = core::mem::MaybeUninit::uninit();
+            let code = unsafe { hairsim_step(world, &input(identity()), report.as_mut_ptr()) };
+            assert_eq!(code, E::Ok);
+            flags |= unsafe { report.assume_init() }.flags;
+        }
+        flags
+    };
+    unsafe {
+        assert_eq!(hairsim_configure(world, &rod), E::Ok);
+        let add = hairsim_add_strand(world, points.as_ptr(), NODES, &material, ptr::null_mut());
+        assert_eq!(add, E::Ok);
+        assert_eq!(
+            hairsim_add_collider(world, &collider, ptr::null_mut()),
+            E::EffectOff
+        );
+        assert_eq!(
+            hairsim_add_grab(world, &grab, ptr::null_mut()),
+            E::EffectOff
+        );
+        // The preset holds the strand's length.
+        assert_eq!(flags_of_steps(world, 100) & HAIRSIM_FLAG_STRETCHED, 0);
+        let mut on = rod;
+        on.effects |= HAIRSIM_EFFECT_COLLISIONS | HAIRSIM_EFFECT_GRABS;
+        assert_eq!(hairsim_configure(world, &on), E::Ok);
+        assert_eq!(
+            hairsim_add_collider(world, &collider, ptr::null_mut()),
+            E::Ok
+        );
+        // Held where node 3 is now.
+        let mut now = [hairsim_vec3::default(); NODES];
+        let copied = hairsim_strand_positions(world, 0, now.as_mut_ptr(), NODES, ptr::null_mut());
+        assert_eq!(copied, E::Ok);
+        let grab = hairsim_grab {
+            strand: 0,
+            node: 3,
+            target: now[3],
+            force_limit: 10.0,
+            ..Default::default()
+        };
+        assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::Ok);
+        let inactive = HAIRSIM_FLAG_COLLIDERS_INACTIVE | HAIRSIM_FLAG_GRABS_INACTIVE;
+        assert_eq!(flags_of_steps(world, 1) & inactive, 0);
+        // Switched off on purpose: they stay, and the report says they did nothing.
+        assert_eq!(hairsim_configure(world, &rod), E::Ok);
+        assert_eq!(flags_of_steps(world, 1) & inactive, inactive);
+        // Gravity alone: the strand stretches, and the report says so.
+        let mut loose = rod;
+        loose.effects = HAIRSIM_EFFECT_GRAVITY;
+        assert_eq!(hairsim_configure(world, &loose), E::Ok);
+        assert_ne!(flags_of_steps(world, 100) & HAIRSIM_FLAG_STRETCHED, 0);
+    }
+}
+
+#[test]
 fn the_firmware_scene_through_the_c_functions_gives_the_core_hash() {
     let scene = Scene::firmware();
     let mut storage = Storage::new();
@@ -559,7 +662,7 @@ fn refused_arguments_have_their_codes() {
             let message = core::ffi::CStr::from_ptr(hairsim_error_message(code));
             assert!(!message.is_empty());
             let unknown = message.to_str().unwrap() == "unknown error code";
-            assert_eq!(unknown, !(0..=22).contains(&code), "{code}");
+            assert_eq!(unknown, !(0..=23).contains(&code), "{code}");
         }
     }
 }

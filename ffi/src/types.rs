@@ -12,7 +12,7 @@
 /// when the ABI breaks and the minor version when it only grows.
 pub const HAIRSIM_VERSION_MAJOR: u32 = 0;
 /// The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
-pub const HAIRSIM_VERSION_MINOR: u32 = 3;
+pub const HAIRSIM_VERSION_MINOR: u32 = 4;
 /// The library's patch version: changes that no header sees (fixes, speed).
 pub const HAIRSIM_VERSION_PATCH: u32 = 0;
 /// The three parts in one word, `0x00MMmmpp`, as `hairsim_version()` returns it; the header's
@@ -89,6 +89,15 @@ pub const HAIRSIM_FLAG_BAD_INPUT: u32 = 1 << 3;
 pub const HAIRSIM_FLAG_SINGULAR: u32 = 1 << 4;
 /// A node was inside more colliders than it has collision rows for.
 pub const HAIRSIM_FLAG_CONTACTS_TRUNCATED: u32 = 1 << 5;
+/// A segment ended the step more than 1 % longer or shorter than its rest length
+/// (`max_stretch` or `max_contact_stretch` above 0.01): inextensibility is off, or contacts
+/// or grabs pull harder than the constraints hold.
+pub const HAIRSIM_FLAG_STRETCHED: u32 = 1 << 6;
+/// The world holds colliders but `HAIRSIM_EFFECT_COLLISIONS` is off: they did nothing.
+pub const HAIRSIM_FLAG_COLLIDERS_INACTIVE: u32 = 1 << 7;
+/// The world holds grabs that hold their node but `HAIRSIM_EFFECT_GRABS` is off: they did
+/// nothing.
+pub const HAIRSIM_FLAG_GRABS_INACTIVE: u32 = 1 << 8;
 
 /// What every function returns: `HAIRSIM_ERROR_OK` (0) or why it refused. A refused call
 /// changes nothing. `hairsim_error_message(code)` says it in words.
@@ -144,6 +153,9 @@ pub enum hairsim_error {
     StrandsMismatch = 21,
     /// `hairsim_init`: the header's `HAIRSIM_NODES` is not the library's.
     NodesMismatch = 22,
+    /// A collider was added while `HAIRSIM_EFFECT_COLLISIONS` is off, or a grab while
+    /// `HAIRSIM_EFFECT_GRABS` is off: it would do nothing. Turn the effect on first.
+    EffectOff = 23,
 }
 
 /// The model (`hairsim_params::solver`).
@@ -288,7 +300,7 @@ pub struct hairsim_material {
     pub minor_axis_penalty: f32,
 }
 
-/// A world's parameters and effects. Start from `hairsim_params_default` and change fields.
+/// A world's parameters and effects. Start from `hairsim_params_preset` and change fields.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct hairsim_params {

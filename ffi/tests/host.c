@@ -34,7 +34,7 @@ static const char *name_of(hairsim_error code) {
         "NOT_FINITE", "OUT_OF_RANGE", "UNSUPPORTED_EFFECT", "TOO_FEW_NODES", "TOO_MANY_NODES",
         "DEGENERATE_SEGMENT", "FOLDED_SEGMENT", "INVALID_MATERIAL", "STRANDS_FULL",
         "COLLIDERS_FULL", "GRABS_FULL", "INVALID_COLLIDER", "INVALID_GRAB", "OVERLAP",
-        "VERSION_MISMATCH", "STRANDS_MISMATCH", "NODES_MISMATCH",
+        "VERSION_MISMATCH", "STRANDS_MISMATCH", "NODES_MISMATCH", "EFFECT_OFF",
     };
     return code >= 0 && (size_t)code < sizeof names / sizeof names[0] ? names[code] : "?";
 }
@@ -177,8 +177,22 @@ static void refusals(void) {
     p.solver = HAIRSIM_SOLVER_DFTL;
     p.effects |= HAIRSIM_EFFECT_GRABS;
     EXPECT(HAIRSIM_ERROR_UNSUPPORTED_EFFECT, hairsim_configure(world, &p));
+
+    /* The default is the rod's preset; a collider or a grab while its effect is off (the
+       presets have neither) is refused. */
+    hairsim_params preset;
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_params_preset(HAIRSIM_SOLVER_ROD, &preset));
+    check(memcmp(&preset, &params, sizeof preset) == 0, "the default is the rod's preset");
+    EXPECT(HAIRSIM_ERROR_OUT_OF_RANGE, hairsim_params_preset(2, &preset));
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_configure(world, &params));
+    hairsim_collider ball = {.shape = HAIRSIM_SHAPE_SPHERE, .attached_to_head = 1,
+                             .radius = 0.05f};
+    EXPECT(HAIRSIM_ERROR_EFFECT_OFF, hairsim_add_collider(world, &ball, NULL));
+    hairsim_grab held = {.strand = 0, .node = 2, .force_limit = 1.0f};
+    EXPECT(HAIRSIM_ERROR_EFFECT_OFF, hairsim_add_grab(world, &held, NULL));
     p = params;
-    p.effects = HAIRSIM_EFFECT_GRAVITY | HAIRSIM_EFFECT_INEXTENSIBILITY | HAIRSIM_EFFECT_GRABS;
+    p.effects = HAIRSIM_EFFECT_GRAVITY | HAIRSIM_EFFECT_INEXTENSIBILITY |
+                HAIRSIM_EFFECT_COLLISIONS | HAIRSIM_EFFECT_GRABS;
     EXPECT(HAIRSIM_ERROR_OK, hairsim_configure(world, &p));
 
     /* Strands: NULL, too few and too many points, NaN, degenerate, folded, bad material,
@@ -222,8 +236,9 @@ static void refusals(void) {
     EXPECT(HAIRSIM_ERROR_STRANDS_FULL, hairsim_add_strand(world, line, 5, &hair, &index));
 
     /* Colliders. */
+    /* Clear of the strands (rooted at the origin): it changes nothing the test looks at. */
     hairsim_collider sphere = {.shape = HAIRSIM_SHAPE_SPHERE, .attached_to_head = 1,
-                               .radius = 0.05f};
+                               .a = {0.0f, -1.0f, 0.0f}, .radius = 0.05f};
     hairsim_collider c = sphere;
     c.shape = 3;
     EXPECT(HAIRSIM_ERROR_OUT_OF_RANGE, hairsim_add_collider(world, &c, NULL));

@@ -261,7 +261,7 @@ fn vec3(v: [F; 3]) -> hairsim_vec3 {
 
 fn check_code(code: hairsim_error) {
     let c = code as i32;
-    assert!((0..=22).contains(&c), "unknown code {c}");
+    assert!((0..=23).contains(&c), "unknown code {c}");
     let message = unsafe { CStr::from_ptr(hairsim_error_message(c)) };
     assert!(!message.is_empty());
 }

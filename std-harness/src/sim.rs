@@ -189,7 +189,7 @@ impl<const N: usize, M: Math> Sim<N, M> {
         let ctx = pipeline::begin(world, &inputs, &mut report);
         let hair_hair = self.hair_hair(&ctx, &mut report);
         self.step_blocks(&ctx, hair_hair, &mut report);
-        pipeline::finish(&mut self.grabs, &report);
+        pipeline::finish(&mut self.grabs, &mut report);
         self.head = ctx.head;
         self.steps += 1;
         report

@@ -24,13 +24,14 @@ pub mod rod_lanes;
 use crate::collide::Collider;
 use crate::context::StepContext;
 use crate::dftl::node::Setup;
-use crate::effects::Solver;
+use crate::effects::{Effect, Solver};
 use crate::grab::{apply_slips, retarget, slip_unreachable, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Params};
-use crate::report::{Flags, StepReport};
+use crate::report::{Flags, StepReport, STRETCH_LIMIT};
 use crate::strand::Strand;
+use crate::stretch::record_stretch;
 use rod::RodScratch;
 use rod_lanes::RodBlockScratch;
 
@@ -69,6 +70,9 @@ pub fn step_strands_with<M: Math, const N: usize>(
             for (k, strand) in strands.iter_mut().enumerate() {
                 let at = (grabs, first_strand + k as u32);
                 rod::step_strand::<M, N>(strand, ctx, at, of_strand(k), scratch, report);
+                if !ctx.gates.projection {
+                    record_stretch::<M, N>(strand, report);
+                }
             }
         }
         Solver::Dftl => {
@@ -120,6 +124,11 @@ pub fn step_strands_in_lanes_with<M: Math, const N: usize, const W: usize>(
         let accelerations = accelerations.and_then(|a| a.get(first * N..(first + block.len()) * N));
         let at = (grabs, first_strand + first as u32);
         rod_lanes::step_block::<M, N, W>(block, ctx, at, accelerations, scratch, report);
+        if !ctx.gates.projection {
+            block
+                .iter()
+                .for_each(|strand| record_stretch::<M, N>(strand, report));
+        }
     }
 }
 
@@ -179,6 +188,7 @@ pub fn begin<const N: usize>(
         report.flags.insert(Flags::BAD_INPUT);
         world.head
     };
+    flag_inactive(world.params, world.colliders, world.grabs, report);
     let time = (world.steps + 1) as Real * world.params.dt;
     let ctx =
         StepContext::with_coefficients(world.params, world.dftl, world.head, head, world.colliders)
@@ -187,9 +197,25 @@ pub fn begin<const N: usize>(
     ctx
 }
 
-/// Ends a step: every grab that slipped during it (`report.grabs_slipped`) lets go.
-pub fn finish(grabs: &mut [Grab], report: &StepReport) {
+/// Flags colliders and holding grabs whose effect is off: a scene may switch `collisions` or
+/// `grabs` off on purpose, and the report says they did nothing.
+fn flag_inactive(params: &Params, colliders: &[Collider], grabs: &[Grab], report: &mut StepReport) {
+    if !colliders.is_empty() && !params.effects.contains(Effect::Collisions) {
+        report.flags.insert(Flags::COLLIDERS_INACTIVE);
+    }
+    let holding = grabs.iter().any(|g| g.status == GrabStatus::Held);
+    if holding && !params.effects.contains(Effect::Grabs) {
+        report.flags.insert(Flags::GRABS_INACTIVE);
+    }
+}
+
+/// Ends a step: every grab that slipped during it (`report.grabs_slipped`) lets go, and a
+/// segment stretched past [`STRETCH_LIMIT`] raises [`Flags::STRETCHED`].
+pub fn finish(grabs: &mut [Grab], report: &mut StepReport) {
     apply_slips(grabs, report);
+    if report.max_stretch.max(report.max_contact_stretch) > STRETCH_LIMIT {
+        report.flags.insert(Flags::STRETCHED);
+    }
 }
 
 #[cfg(test)]

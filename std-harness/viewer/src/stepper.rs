@@ -188,7 +188,7 @@ impl<const N: usize> Stepper<N> {
                 );
             }
         }
-        pipeline::finish(&mut self.grabs, &report);
+        pipeline::finish(&mut self.grabs, &mut report);
         self.head = ctx.head;
         self.steps += 1;
         self.report = report;

@@ -154,6 +154,9 @@ fn param_field(error: ParamError) -> FieldError {
             "effects",
             format!("the {solver} solver cannot do \"{effect}\""),
         ),
+        ParamError::EffectOff { effect, item } => {
+            FieldError::new("effects", format!("{item} needs \"{effect}\""))
+        }
     }
 }
 
