@@ -151,6 +151,16 @@ impl Solver {
         }
     }
 
+    /// Whether this build has the solver: its cargo feature (`rod`, `dftl`; both by default) is
+    /// on.
+    #[must_use]
+    pub const fn is_built(self) -> bool {
+        match self {
+            Solver::Rod => cfg!(feature = "rod"),
+            Solver::Dftl => cfg!(feature = "dftl"),
+        }
+    }
+
     /// Whether this solver can simulate `effect`: bending and twist need the rod's energies,
     /// shape preservation is DFTL's.
     #[must_use]

@@ -293,8 +293,14 @@ impl Params {
         ..Params::ROD
     };
 
-    /// The rod's preset, [`Params::ROD`]: what `World::new` starts from.
-    pub const DEFAULT: Params = Params::ROD;
+    /// The rod's preset, [`Params::ROD`]: what `World::new` starts from. In a build without
+    /// the rod (its cargo feature off) DFTL's, [`Params::DFTL`]: a new world is always one this
+    /// build can step.
+    pub const DEFAULT: Params = if cfg!(feature = "rod") {
+        Params::ROD
+    } else {
+        Params::DFTL
+    };
 
     /// The preset of `solver`: the effects and values hair needs ([`Params::ROD`],
     /// [`Params::DFTL`]). Start from it and change what the scene needs.
@@ -307,7 +313,7 @@ impl Params {
     }
 
     /// Checks every parameter against its range and the effects against the solver (the
-    /// first failure, in this order: time step, forces, rod, DFTL, wind, effects).
+    /// first failure, in this order: the solver, time step, forces, rod, DFTL, wind, effects).
     pub fn validate(&self) -> Result<(), ParamError> {
         self.validate_time_step_and_forces()?;
         self.validate_rod()?;
@@ -324,6 +330,12 @@ impl Params {
 
     /// The time step (for the solver) and the scene's gravity and drag.
     fn validate_time_step_and_forces(&self) -> Result<(), ParamError> {
+        range(
+            self.solver.is_built(),
+            "solver",
+            "a solver this build has: `rod` and `dftl`, unless the core was built without one \
+             (its cargo feature off)",
+        )?;
         range(
             self.dt.is_finite() && (MIN_DT..=MAX_DT).contains(&self.dt),
             "dt",

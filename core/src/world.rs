@@ -56,8 +56,8 @@ impl<const S: usize, const N: usize, M: Math> Default for World<S, N, M> {
 }
 
 impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
-    /// An empty world with [`Params::DEFAULT`] (the rod's preset): usable to initialise a
-    /// `static`.
+    /// An empty world with [`Params::DEFAULT`] (the rod's preset; DFTL's in a build without the
+    /// rod): usable to initialise a `static`.
     #[must_use]
     pub const fn new() -> Self {
         World {

@@ -946,8 +946,9 @@ hairsim_error hairsim_init_versioned(struct hairsim_world *buffer,
 hairsim_error hairsim_params_preset(uint32_t solver, struct hairsim_params *out);
 
 /**
- * Fills `out` with the rod's preset: `hairsim_params_preset(HAIRSIM_SOLVER_ROD, out)`, the
- * parameters `hairsim_init` gives a world.
+ * Fills `out` with the parameters `hairsim_init` gives a world: the rod's preset,
+ * `hairsim_params_preset(HAIRSIM_SOLVER_ROD, out)` (DFTL's in a library built without the
+ * rod).
  *
  * # Safety
  * `out`, if not NULL, must be valid for writes of a `hairsim_params`.

@@ -391,8 +391,9 @@ pub unsafe extern "C" fn hairsim_params_preset(
     code(unsafe { write(out, convert::params_to_c(&preset)) })
 }
 
-/// Fills `out` with the rod's preset: `hairsim_params_preset(HAIRSIM_SOLVER_ROD, out)`, the
-/// parameters `hairsim_init` gives a world.
+/// Fills `out` with the parameters `hairsim_init` gives a world: the rod's preset,
+/// `hairsim_params_preset(HAIRSIM_SOLVER_ROD, out)` (DFTL's in a library built without the
+/// rod).
 ///
 /// # Safety
 /// `out`, if not NULL, must be valid for writes of a `hairsim_params`.

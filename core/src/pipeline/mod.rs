@@ -62,8 +62,10 @@ pub fn step_strands_with<M: Math, const N: usize>(
     report: &mut StepReport,
 ) {
     let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
+    // A solver this build leaves out (`Solver::is_built`) steps nothing: `Params::validate`
+    // refused it, and its code is not linked.
     match ctx.params.solver {
-        Solver::Rod => {
+        Solver::Rod if cfg!(feature = "rod") => {
             // One scratch space for all the call's strands.
             let mut own = None;
             let scratch = scratch.unwrap_or_else(|| own.insert(RodScratch::<M, N>::new()));
@@ -75,7 +77,7 @@ pub fn step_strands_with<M: Math, const N: usize>(
                 }
             }
         }
-        Solver::Dftl => {
+        Solver::Dftl if cfg!(feature = "dftl") => {
             // What a DFTL step derives from the context (the head's rotation matrix among it)
             // is the same for every strand: once per block.
             let setup = Setup::new(ctx);
@@ -85,6 +87,7 @@ pub fn step_strands_with<M: Math, const N: usize>(
                 dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand(k), report);
             }
         }
+        Solver::Rod | Solver::Dftl => {}
     }
 }
 
@@ -116,7 +119,7 @@ pub fn step_strands_in_lanes_with<M: Math, const N: usize, const W: usize>(
     scratch: &mut RodBlockScratch<M, N, W>,
     report: &mut StepReport,
 ) {
-    if ctx.params.solver != Solver::Rod {
+    if ctx.params.solver != Solver::Rod || !cfg!(feature = "rod") {
         return step_strands::<M, N>(ctx, strands, first_strand, grabs, accelerations, report);
     }
     for (b, block) in strands.chunks_mut(W.max(1)).enumerate() {
