@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Writes the C header of hairsim-ffi: include/hairsim.h, or the file given as $1, for the
-# capacities in HAIRSIM_STRANDS and HAIRSIM_NODES (default 4 and 16; the committed header is the
-# default's). cbindgen writes the declarations; the capacities and the world's size and
-# alignment, which cbindgen cannot evaluate, come from the unit test `tests::header_defines`,
-# run on this 64-bit host: a 32-bit target's world is no larger (only its `usize` fields
-# shrink), and `hairsim_init` checks the buffer against the running target's own size.
+# Writes the C header of hairsim-ffi: include/hairsim.h, or the file given as $1. One header
+# serves every capacity: a program built for a library of other capacities than the default
+# 4 x 16 defines HAIRSIM_STRANDS and HAIRSIM_NODES before including it. cbindgen writes the
+# declarations; the world's size as a formula of the capacities and its alignment, which
+# cbindgen cannot evaluate, come from the unit test `tests::header_defines`, run on this 64-bit
+# host: a 32-bit target's world is no larger (only its `usize` fields shrink), and
+# `hairsim_init` checks the buffer against the running target's own size. The summary of the
+# sizing table (ffi/sizing.txt, written by ffi/sizing.py) goes into the banner.
 set -euo pipefail
 CBINDGEN_VERSION=0.29.4
 out=${1:-}
@@ -21,10 +23,12 @@ fi
 
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-cargo test -q --lib -- --exact tests::header_defines --nocapture >"$tmp/test.out"
+# At the default capacities, whatever the environment says: the text does not depend on them.
+env -u HAIRSIM_STRANDS -u HAIRSIM_NODES \
+  cargo test -q --lib -- --exact tests::header_defines --nocapture >"$tmp/test.out"
 sed -n '/^@HAIRSIM_CAPACITY_BEGIN@$/,/^@HAIRSIM_CAPACITY_END@$/p' "$tmp/test.out" |
   sed '1d;$d' >"$tmp/capacity.h"
-grep -q '^#define HAIRSIM_WORLD_SIZE [0-9]' "$tmp/capacity.h" || {
+grep -q '^#define HAIRSIM_WORLD_SIZE_FOR' "$tmp/capacity.h" || {
   echo "tests::header_defines printed no capacities:"; cat "$tmp/test.out"; exit 1
 } >&2
 cat >>"$tmp/capacity.h" <<'C'
@@ -48,9 +52,11 @@ cat >>"$tmp/capacity.h" <<'C'
 C
 
 cbindgen --quiet --config cbindgen.toml --crate hairsim-ffi --output "$tmp/hairsim.h"
-# The capacities replace cbindgen's placeholder; the version goes into the banner.
-awk -v capacity="$tmp/capacity.h" -v version="$CBINDGEN_VERSION" '
+# The capacities replace cbindgen's placeholder; the version and the sizing summary go into
+# the banner.
+awk -v capacity="$tmp/capacity.h" -v version="$CBINDGEN_VERSION" -v sizing="$PWD/sizing.txt" '
   /^\/\* @HAIRSIM_CAPACITY@ \*\/$/ { print ""; while ((getline line < capacity) > 0) print line; next }
+  /^ \* @HAIRSIM_SIZING@$/ { while ((getline line < sizing) > 0) print line; next }
   { gsub(/@CBINDGEN_VERSION@/, version); print }
 ' "$tmp/hairsim.h" >"$out"
-echo "wrote $out (HAIRSIM_STRANDS=${HAIRSIM_STRANDS:-4} HAIRSIM_NODES=${HAIRSIM_NODES:-16})"
+echo "wrote $out"

@@ -12,14 +12,15 @@ SECOND_LINE = re.compile(r"^\s+0x([0-9a-f]+)\s+0x([0-9a-f]+)\s+(\S.*)$")
 
 
 def origin(path):
-    if "libhairsim_ffi.a" in path:
+    if "libhairsim_ffi.a" in path or "libhairsim.a" in path:
         return "hairsim library"
     if any(f"/{lib}(" in path for lib in NEWLIB):
         return "newlib + libgcc"
     return "C example"
 
 
-def main(path):
+def by_origin(path):
+    """Flash and static RAM bytes by origin: two dicts keyed like `origin` names."""
     flash, ram = {}, {}
     output = None
     in_map = False
@@ -49,6 +50,11 @@ def main(path):
             flash[who] = flash.get(who, 0) + size
         if output in RAM:
             ram[who] = ram.get(who, 0) + size
+    return flash, ram
+
+
+def main(path):
+    flash, ram = by_origin(path)
     order = ["hairsim library", "C example", "newlib + libgcc"]
     print("flash by origin, bytes: " + ", ".join(f"{k} {flash.get(k, 0)}" for k in order)
           + f" (total {sum(flash.values())})")

@@ -84,14 +84,17 @@ const IDLE: u32 = 0x4841_4952;
 /// The state word while a call uses the world ("HAIr").
 const BUSY: u32 = 0x4841_4972;
 
-/// What the caller's world buffer holds.
+/// What the caller's world buffer holds, for a world of `S` strands of `N` nodes.
 #[repr(C)]
-pub(crate) struct Cell {
+pub(crate) struct CellOf<const S: usize, const N: usize> {
     /// `IDLE`, `BUSY`, or anything else before `hairsim_init`.
     state: AtomicU32,
     /// The world; only reached through a [`Lease`].
-    world: SimWorld,
+    world: World<S, N, DefaultMath>,
 }
+
+/// What the caller's world buffer holds, at the build-time capacities.
+pub(crate) type Cell = CellOf<STRANDS, NODES>;
 
 /// Bytes a world buffer needs on this target.
 pub(crate) const WORLD_SIZE: usize = size_of::<Cell>();

@@ -101,24 +101,83 @@ fn rust_firmware_hash() -> u64 {
     firmware::run(&mut world, firmware::STEPS).unwrap()
 }
 
-/// `generate-header.sh` reads the capacities and the world's layout from here.
+/// Bytes of a world of `S` strands of `N` nodes, for each capacity of a grid: what
+/// [`world_size_formula`] is fitted to and checked against.
+macro_rules! world_sizes {
+    ($($s:literal x [$($n:literal),*]),*) => {
+        [$($(($s, $n, core::mem::size_of::<CellOf<$s, $n>>()),)*)*]
+    };
+}
+
+/// `(A, B, C, D)` of `A + B N + S (C + D N)`: the bytes a world of `S` strands of `N` nodes
+/// needs at most, measured on this 64-bit host (a 32-bit target's world is no larger: only its
+/// `usize` fields shrink). A world is a fixed part, a scratch space that grows with `N`, and
+/// `S` strands of `C + D N` bytes each (exactly); the fixed part and the scratch space are
+/// rounded to 8 bytes at a few places, so `A + B N` is their upper envelope.
+fn world_size_formula() -> (usize, usize, usize, usize) {
+    let sizes = world_sizes!(
+        1 x [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 16, 17, 23, 24, 31, 32, 33, 48, 63, 64,
+             100, 127, 128, 255, 256, 511, 1000, 1024, 2047, 4096],
+        2 x [3, 4, 5, 16, 17, 64, 4096],
+        3 x [3, 16, 33],
+        8 x [3, 24, 32, 1000],
+        64 x [7, 16, 32],
+        4096 x [3, 4096]
+    );
+    let size = |s, n| sizes.iter().find(|&&(a, b, _)| (a, b) == (s, n)).unwrap().2;
+    // Per strand, from two strand counts at two node counts.
+    let strand = |n| size(2, n) - size(1, n);
+    let d = (strand(4096) - strand(3)) / (4096 - 3);
+    let c = strand(3) - 3 * d;
+    // The rest: its slope from the fewest nodes to the most, rounded up, then the least
+    // intercept that covers every point of the grid, plus one 8-byte rounding for the node
+    // counts between them.
+    let rest = |n: usize| size(1, n) - (c + d * n);
+    let b = (rest(4096) - rest(3)).div_ceil(4096 - 3);
+    let ones = sizes.iter().filter(|t| t.0 == 1).map(|t| t.1);
+    let a = ones.map(|n| rest(n) as i64 - (b * n) as i64).max().unwrap() + 8;
+    let a = usize::try_from(a).expect("the fixed part is positive");
+    for &(s, n, bytes) in &sizes {
+        let formula = a + b * n + s * (c + d * n);
+        assert!(bytes <= formula, "{s} x {n}: {bytes} > {formula}");
+        assert!(
+            formula - bytes <= 8 * 16,
+            "{s} x {n}: {bytes} far below {formula}"
+        );
+    }
+    (a, b, c, d)
+}
+
+/// `generate-header.sh` reads the capacities' defaults and the world's size formula from here.
 #[test]
 fn header_defines() {
-    std::println!("@HAIRSIM_CAPACITY_BEGIN@");
-    std::println!(
-        "/** Strand capacity of a world (HAIRSIM_STRANDS when the library was built). */"
+    let (a, b, c, d) = world_size_formula();
+    assert!(a + b * NODES + STRANDS * (c + d * NODES) >= WORLD_SIZE);
+    let text = format!(
+        "/**
+ * The capacities the library was built with (HAIRSIM_STRANDS and HAIRSIM_NODES in cargo's
+ * environment; 4 and 16 when unset). Define them to the library's before including this
+ * header when they are not the defaults: hairsim_init refuses a world of other capacities.
+ */
+#ifndef HAIRSIM_STRANDS
+#define HAIRSIM_STRANDS 4
+#endif
+#ifndef HAIRSIM_NODES
+#define HAIRSIM_NODES 16
+#endif
+/**
+ * Bytes of a world buffer of `strands` strands of `nodes` nodes: measured on a 64-bit host,
+ * no fewer than a 32-bit target needs (hairsim_get_capacity gives the running target's own).
+ */
+#define HAIRSIM_WORLD_SIZE_FOR(strands, nodes) \\
+  ((size_t){a}u + (size_t){b}u * (size_t)(nodes) + \\
+   (size_t)(strands) * ((size_t){c}u + (size_t){d}u * (size_t)(nodes)))
+/** Bytes of a world buffer at HAIRSIM_STRANDS and HAIRSIM_NODES. */
+#define HAIRSIM_WORLD_SIZE HAIRSIM_WORLD_SIZE_FOR(HAIRSIM_STRANDS, HAIRSIM_NODES)
+/** Alignment of a world buffer, bytes. */
+#define HAIRSIM_WORLD_ALIGN {WORLD_ALIGN}"
     );
-    std::println!("#define HAIRSIM_STRANDS {STRANDS}");
-    std::println!("/** Node capacity per strand (HAIRSIM_NODES when the library was built). */");
-    std::println!("#define HAIRSIM_NODES {NODES}");
-    std::println!(
-        "/** Bytes of a world buffer: measured on a 64-bit host, no fewer than a 32-bit target \
-         needs. */"
-    );
-    std::println!("#define HAIRSIM_WORLD_SIZE {WORLD_SIZE}");
-    std::println!("/** Alignment of a world buffer, bytes. */");
-    std::println!("#define HAIRSIM_WORLD_ALIGN {WORLD_ALIGN}");
-    std::println!("@HAIRSIM_CAPACITY_END@");
+    std::println!("@HAIRSIM_CAPACITY_BEGIN@\n{text}\n@HAIRSIM_CAPACITY_END@");
     const { assert!(usize::BITS == 64, "measure on a 64-bit host") };
 }
 

@@ -5,9 +5,10 @@
  * argument it must refuse and checks the code. Re-entry is provoked by a timer signal whose
  * handler calls into the world the main program is stepping.
  *
- * Built and run by .ci/ffi:
- *   cc -std=c11 -O2 -ffp-contract=off -Iffi/include -Iffi/tests ffi/tests/host.c \
- *      ffi/tests/firmware_scene.c ffi/target/release/libhairsim_ffi.a -o host && ./host 0x...
+ * Also runs the C example (firmware-c/example.c). Built and run by .ci/ffi:
+ *   cc -std=c11 -O2 -ffp-contract=off -Iffi/include -Iffi/tests -Ifirmware-c ffi/tests/host.c \
+ *      ffi/tests/firmware_scene.c firmware-c/example.c ffi/target/release/libhairsim_ffi.a \
+ *      -o host && ./host 0x...
  */
 #define _POSIX_C_SOURCE 200809L
 
@@ -19,12 +20,14 @@
 #include <sys/time.h>
 #include <time.h>
 
+#include "example.h"
 #include "firmware_scene.h"
 #include "hairsim.h"
 
 static HAIRSIM_WORLD_STORAGE(scene_storage);
 static HAIRSIM_WORLD_STORAGE(refusal_storage);
 static HAIRSIM_WORLD_STORAGE(busy_storage);
+static HAIRSIM_WORLD_STORAGE(example_storage);
 
 static unsigned passed, failed;
 
@@ -407,8 +410,18 @@ static void reentry(void) {
     EXPECT(HAIRSIM_ERROR_OK, hairsim_state_hash(world, &hash));
 }
 
+static void print_line(const char *text) { printf("%s\n", text); }
+
+/* firmware-c/example.c, as the C firmware runs it: .ci/ffi compares the lines both print. */
+static void example(void) {
+    hairsim_world *world = (hairsim_world *)example_storage;
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_init(world, sizeof example_storage));
+    EXPECT(HAIRSIM_ERROR_OK, example_run(world, print_line));
+}
+
 int main(int argc, char **argv) {
     uint64_t hash = 0;
+    example();
     int scene_failed = run_scene(&hash);
     check(!scene_failed, "the scene ran, every node finite");
     if (argc > 1) {
