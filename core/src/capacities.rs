@@ -22,3 +22,7 @@ pub const NAMED_STRANDS: usize = 8;
 
 /// Shortest rest segment a strand may have, m.
 pub const MIN_SEGMENT_LENGTH: Real = 1.0e-6;
+
+/// Longest rest segment a strand may have, m: no hair has a metre between two nodes, and a
+/// polyline given in the wrong unit (millimetres as metres) is caught here.
+pub const MAX_SEGMENT_LENGTH: Real = 1.0;

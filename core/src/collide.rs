@@ -2,6 +2,7 @@
 //! A collider may be attached to the head, in which case it is given in the head's frame and
 //! moves with it.
 
+use crate::error::ParamError;
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 
@@ -127,19 +128,57 @@ impl Shape {
         }
     }
 
-    /// Whether every parameter is finite and in range: a radius from [`MIN_RADIUS`] to
-    /// [`MAX_RADIUS`], a unit plane normal.
+    /// Whether every parameter is finite and in range ([`Shape::check`]).
     #[must_use]
     pub fn is_valid(&self) -> bool {
+        self.check().is_ok()
+    }
+
+    /// Checks every parameter, naming the first one out of range: finite points, a radius
+    /// from [`MIN_RADIUS`] to [`MAX_RADIUS`], a unit plane normal.
+    pub fn check(&self) -> Result<(), ParamError> {
         use crate::math::is_finite;
-        let radius_ok = |r: Real| (MIN_RADIUS..=MAX_RADIUS).contains(&r);
+        let point = |ok: bool, field| {
+            if ok {
+                Ok(())
+            } else {
+                Err(ParamError::OutOfRange {
+                    field,
+                    allowed: "finite coordinates, m",
+                })
+            }
+        };
+        let radius = |r: Real| {
+            if (MIN_RADIUS..=MAX_RADIUS).contains(&r) {
+                Ok(())
+            } else {
+                Err(ParamError::OutOfRange {
+                    field: "collider.radius",
+                    allowed: "1e-5 m to 1e4 m",
+                })
+            }
+        };
         match *self {
-            Shape::Sphere { centre, radius } => is_finite(centre) && radius_ok(radius),
-            Shape::Capsule { a, b, radius } => is_finite(a) && is_finite(b) && radius_ok(radius),
-            Shape::Plane { point, normal } => {
-                is_finite(point)
-                    && is_finite(normal)
-                    && (normal.length_squared() - 1.0).abs() < 1e-4
+            Shape::Sphere { centre, radius: r } => {
+                point(is_finite(centre), "collider.centre")?;
+                radius(r)
+            }
+            Shape::Capsule { a, b, radius: r } => {
+                point(is_finite(a), "collider.a")?;
+                point(is_finite(b), "collider.b")?;
+                radius(r)
+            }
+            Shape::Plane { point: p, normal } => {
+                point(is_finite(p), "collider.point")?;
+                let unit = is_finite(normal) && (normal.length_squared() - 1.0).abs() < 1e-4;
+                if unit {
+                    Ok(())
+                } else {
+                    Err(ParamError::OutOfRange {
+                        field: "collider.normal",
+                        allowed: "a finite unit vector",
+                    })
+                }
             }
         }
     }

@@ -29,6 +29,11 @@ pub enum BuildError {
         /// Index of the segment (between nodes `segment` and `segment + 1`).
         segment: usize,
     },
+    /// A segment is longer than [`crate::capacities::MAX_SEGMENT_LENGTH`].
+    LongSegment {
+        /// Index of the segment (between nodes `segment` and `segment + 1`).
+        segment: usize,
+    },
     /// Two consecutive segments fold back onto each other (turning angle of π): the curvature
     /// binormal is undefined there.
     FoldedSegment {
@@ -62,6 +67,11 @@ impl fmt::Display for BuildError {
                 f,
                 "segment {segment} is shorter than {} m",
                 crate::capacities::MIN_SEGMENT_LENGTH
+            ),
+            BuildError::LongSegment { segment } => write!(
+                f,
+                "segment {segment} is longer than {} m",
+                crate::capacities::MAX_SEGMENT_LENGTH
             ),
             BuildError::FoldedSegment { node } => write!(
                 f,

@@ -2,6 +2,7 @@
 //! pinned to it (prescribed, Kmoch 2009 Sec. 8.1), or pulled toward it by a virtual coupling
 //! ([`Coupling`]).
 
+use crate::error::ParamError;
 use crate::math::{Real, Vec3};
 
 pub use crate::capacities::MAX_GRABS;
@@ -55,9 +56,28 @@ impl Coupling {
     /// Whether both values lie in their ranges (NaN does not).
     #[must_use]
     pub fn is_valid(&self) -> bool {
+        self.check().is_ok()
+    }
+
+    /// Checks both values, naming the first out of its range (NaN is):
+    /// `grab.coupling.stiffness` ([`Coupling::STIFFNESS`]), then `grab.coupling.damping`
+    /// ([`Coupling::DAMPING`]).
+    pub fn check(&self) -> Result<(), ParamError> {
         let (k_low, k_high) = Self::STIFFNESS;
         let (b_low, b_high) = Self::DAMPING;
-        (k_low..=k_high).contains(&self.stiffness) && (b_low..=b_high).contains(&self.damping)
+        if !(k_low..=k_high).contains(&self.stiffness) {
+            return Err(ParamError::OutOfRange {
+                field: "grab.coupling.stiffness",
+                allowed: "1e-3 to 1e5 N/m",
+            });
+        }
+        if !(b_low..=b_high).contains(&self.damping) {
+            return Err(ParamError::OutOfRange {
+                field: "grab.coupling.damping",
+                allowed: "0 to 1e3 N·s/m",
+            });
+        }
+        Ok(())
     }
 }
 
@@ -389,6 +409,34 @@ mod tests {
     use crate::params::{Params, Solver};
     use crate::strand::{Material, Strand};
     use crate::world::{StepInput, World};
+
+    #[test]
+    fn a_coupling_out_of_range_names_its_field() {
+        let out = |field| {
+            Err(ParamError::OutOfRange {
+                field,
+                allowed: match field {
+                    "grab.coupling.stiffness" => "1e-3 to 1e5 N/m",
+                    _ => "0 to 1e3 N·s/m",
+                },
+            })
+        };
+        assert_eq!(Coupling::new(50.0, 0.01).check(), Ok(()));
+        assert_eq!(Coupling::new(1.0e-3, 0.0).check(), Ok(()));
+        assert_eq!(
+            Coupling::new(1.0e6, 0.01).check(),
+            out("grab.coupling.stiffness")
+        );
+        assert_eq!(
+            Coupling::new(Real::NAN, 0.01).check(),
+            out("grab.coupling.stiffness")
+        );
+        assert_eq!(
+            Coupling::new(50.0, -1.0).check(),
+            out("grab.coupling.damping")
+        );
+        assert!(!Coupling::new(50.0, Real::INFINITY).is_valid());
+    }
 
     /// Two straight 5 cm strands (6 nodes, 1 cm apart) along x, the rod with grabs.
     fn world() -> World<2, 8, Libm> {

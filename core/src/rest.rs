@@ -3,7 +3,7 @@
 //! the rest segment lengths and node masses, the rod's rest data (`rod::rest`) and DFTL's
 //! (`dftl::rest`), and a state at rest. Runs once per strand, never in a step.
 
-use crate::capacities::MIN_SEGMENT_LENGTH;
+use crate::capacities::{MAX_SEGMENT_LENGTH, MIN_SEGMENT_LENGTH};
 use crate::error::BuildError;
 use crate::frames::rest_root_frame;
 use crate::math::{Libm, Math, Real, Vec3};
@@ -89,7 +89,10 @@ fn lengths_and_masses<const N: usize>(
     for j in 0..nodes - 1 {
         let e = points[j + 1] - points[j];
         let length = Libm::length(e);
-        if !length.is_finite() || length < MIN_SEGMENT_LENGTH {
+        if !length.is_finite() || length > MAX_SEGMENT_LENGTH {
+            return Err(BuildError::LongSegment { segment: j });
+        }
+        if length < MIN_SEGMENT_LENGTH {
             return Err(BuildError::DegenerateSegment { segment: j });
         }
         if j > 0 {

@@ -121,13 +121,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// step reports them inactive, [`crate::report::Flags::COLLIDERS_INACTIVE`].)
     pub fn add_collider(&mut self, collider: Collider) -> Result<usize, Error> {
         self.needs(Effect::Collisions, "a collider")?;
-        if !collider.shape.is_valid() {
-            return Err(ParamError::OutOfRange {
-                field: "collider",
-                allowed: "finite coordinates, a radius from 1e-5 to 1e4 m, a unit plane normal",
-            }
-            .into());
-        }
+        collider.shape.check()?;
         self.colliders
             .push(collider)
             .map_err(|_| CapacityError::Colliders {
@@ -141,25 +135,24 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// [`crate::report::Flags::GRABS_INACTIVE`]).
     pub fn add_grab(&mut self, grab: Grab) -> Result<usize, Error> {
         self.needs(Effect::Grabs, "a grab")?;
-        let strand = self.strands.get(grab.strand as usize);
-        let node_ok = strand.is_some_and(|s| grab.node >= 2 && (grab.node as usize) < s.nodes());
-        if !node_ok
-            || !crate::math::is_finite(grab.target)
-            || grab.force_limit.is_nan()
-            || grab.force_limit <= 0.0
-        {
-            return Err(ParamError::OutOfRange {
-                field: "grab",
-                allowed: "an existing strand, a node from 2 to its last, a finite target, force_limit > 0",
-            }
-            .into());
+        let refuse = |field, allowed| Err(ParamError::OutOfRange { field, allowed }.into());
+        let Some(strand) = self.strands.get(grab.strand as usize) else {
+            return refuse("grab.strand", "the index of a strand the world holds");
+        };
+        if grab.node < 2 || grab.node as usize >= strand.nodes() {
+            return refuse(
+                "grab.node",
+                "2 (nodes 0 and 1 follow the head) to the strand's last",
+            );
         }
-        if grab.coupling.is_some_and(|c| !c.is_valid()) {
-            return Err(ParamError::OutOfRange {
-                field: "grab.coupling",
-                allowed: "stiffness 1e-3 to 1e5 N/m, damping 0 to 1e3 N·s/m",
-            }
-            .into());
+        if !crate::math::is_finite(grab.target) {
+            return refuse("grab.target", "finite coordinates, m");
+        }
+        if grab.force_limit.is_nan() || grab.force_limit <= 0.0 {
+            return refuse("grab.force_limit", "> 0 N (infinite: it never slips)");
+        }
+        if let Some(coupling) = grab.coupling {
+            coupling.check()?;
         }
         let grab = Grab {
             previous_target: grab.target,

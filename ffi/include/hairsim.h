@@ -75,7 +75,7 @@
  * no fewer than a 32-bit target needs (hairsim_get_capacity gives the running target's own).
  */
 #define HAIRSIM_WORLD_SIZE_FOR(strands, nodes) \
-  ((size_t)1279u + (size_t)343u * (size_t)(nodes) + \
+  ((size_t)1287u + (size_t)343u * (size_t)(nodes) + \
    (size_t)(strands) * ((size_t)72u + (size_t)120u * (size_t)(nodes)))
 /** Bytes of a world buffer at HAIRSIM_STRANDS and HAIRSIM_NODES. */
 #define HAIRSIM_WORLD_SIZE HAIRSIM_WORLD_SIZE_FOR(HAIRSIM_STRANDS, HAIRSIM_NODES)
@@ -110,7 +110,7 @@
 /**
  * The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
  */
-#define HAIRSIM_VERSION_MINOR 4
+#define HAIRSIM_VERSION_MINOR 5
 
 /**
  * The library's patch version: changes that no header sees (fixes, speed).
@@ -296,7 +296,8 @@ enum hairsim_error
    */
   HAIRSIM_ERROR_TOO_MANY_NODES = 10,
   /**
-   * A polyline segment is shorter than 1 micrometre.
+   * A polyline segment is shorter than 1 micrometre (`hairsim_last_refusal` gives its
+   * index).
    */
   HAIRSIM_ERROR_DEGENERATE_SEGMENT = 11,
   /**
@@ -350,6 +351,10 @@ enum hairsim_error
    * `HAIRSIM_EFFECT_GRABS` is off: it would do nothing. Turn the effect on first.
    */
   HAIRSIM_ERROR_EFFECT_OFF = 23,
+  /**
+   * A polyline segment is longer than 1 m.
+   */
+  HAIRSIM_ERROR_LONG_SEGMENT = 24,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -615,27 +620,29 @@ typedef struct hairsim_params {
 } hairsim_params;
 
 /**
- * A round hair fibre's material (SI units).
+ * A round hair fibre's material (SI units). Each field has a range (outside it:
+ * `HAIRSIM_ERROR_INVALID_MATERIAL`, the field named by `hairsim_last_refusal`); both solvers'
+ * presets hold at every corner of the ranges (docs/embedding.md).
  */
 typedef struct hairsim_material {
   /**
-   * Young's modulus E, Pa.
+   * Young's modulus E, Pa: 1e7 to 1e13 (human hair 3.5e9).
    */
   float youngs_modulus;
   /**
-   * Shear modulus G, Pa.
+   * Shear modulus G, Pa: 1e7 to 1e13 (human hair 1.3e9).
    */
   float shear_modulus;
   /**
-   * Fibre radius, m (0 < r <= 0.01).
+   * Fibre radius, m: 1e-5 to 5e-4 (human hair 4e-5).
    */
   float radius;
   /**
-   * Density, kg/m^3.
+   * Density, kg/m^3: 500 to 3000 (human hair 1300).
    */
   float density;
   /**
-   * Multiplier on bending about the minor axis, 1 to 100.
+   * Multiplier on bending about the minor axis (an elliptic section), 1 to 10.
    */
   float minor_axis_penalty;
 } hairsim_material;
@@ -868,6 +875,36 @@ typedef struct hairsim_world_info {
 } hairsim_world_info;
 
 /**
+ * What the last call on a world that reached it refused, or that it succeeded
+ * (`hairsim_last_refusal`). The strings are static and never NULL ("" for none).
+ */
+typedef struct hairsim_refusal {
+  /**
+   * The `hairsim_error` the call returned (`HAIRSIM_ERROR_OK` when it succeeded).
+   */
+  int32_t code;
+  /**
+   * The function, e.g. "hairsim_add_strand" ("" before any call).
+   */
+  const char *function;
+  /**
+   * The argument refused, as the header names it, e.g. "material" ("" for none).
+   */
+  const char *argument;
+  /**
+   * The field of that argument, as the header names it, e.g. "radius" ("" for the whole
+   * argument).
+   */
+  const char *field;
+  /**
+   * The node, segment, strand or array element concerned, or `UINT32_MAX` for none: the
+   * node of a non-finite point, the segment too short or too long, the node a polyline
+   * folds at, the grab target or acceleration that is not finite.
+   */
+  uint32_t index;
+} hairsim_refusal;
+
+/**
  * A head shake: rotation about the unit `axis` through `centre` by
  * `amplitude * sin(2 pi frequency t)`.
  */
@@ -1019,7 +1056,9 @@ hairsim_error hairsim_configure(struct hairsim_world *world, const struct hairsi
 
 /**
  * Adds a strand at rest along the polyline `points[0 .. count)` (root first, in the head's
- * frame, 3 to `HAIRSIM_NODES` points), of `material`. Its index goes to `index` if not NULL.
+ * frame, 3 to `HAIRSIM_NODES` points, each segment from 1e-6 m to 1 m long), of `material`.
+ * Its index goes to `index` if not NULL. A refused point or segment is named by
+ * `hairsim_last_refusal` (argument `points`, its index).
  *
  * # Safety
  * `world` as for `hairsim_init`; `points`, if not NULL, valid for reads of `count`
@@ -1033,7 +1072,8 @@ hairsim_error hairsim_add_strand(struct hairsim_world *world,
                                  uint32_t *index);
 
 /**
- * Adds a collider (at most `HAIRSIM_MAX_COLLIDERS`). Its index goes to `index` if not NULL.
+ * Adds a collider (at most `HAIRSIM_MAX_COLLIDERS`; `HAIRSIM_EFFECT_COLLISIONS` must be on).
+ * Its index goes to `index` if not NULL.
  *
  * # Safety
  * `world` as for `hairsim_init`; `collider`, if not NULL, valid for reads of a
@@ -1044,8 +1084,8 @@ hairsim_error hairsim_add_collider(struct hairsim_world *world,
                                    uint32_t *index);
 
 /**
- * Adds a grab (at most `HAIRSIM_MAX_GRABS`) on a strand already added. Its index goes to
- * `index` if not NULL.
+ * Adds a grab (at most `HAIRSIM_MAX_GRABS`; `HAIRSIM_EFFECT_GRABS` must be on) on a strand
+ * already added. Its index goes to `index` if not NULL.
  *
  * # Safety
  * `world` as for `hairsim_init`; `grab`, if not NULL, valid for reads of a `hairsim_grab`;
@@ -1068,7 +1108,7 @@ hairsim_error hairsim_release_grab(struct hairsim_world *world, uint32_t grab);
  * moves the head to `input->head` and steps every strand. The report goes to `report` if not
  * NULL. A non-finite or non-unit pose, a non-finite target or acceleration, more targets than
  * grabs or more accelerations than `HAIRSIM_STRANDS * HAIRSIM_NODES` are refused before
- * anything changes.
+ * anything changes (`hairsim_last_refusal` names the field and the element).
  *
  * # Safety
  * `world` as for `hairsim_init`; `input`, if not NULL, valid for reads of a
@@ -1112,6 +1152,19 @@ hairsim_error hairsim_state_hash(struct hairsim_world *world, uint64_t *out);
  * `hairsim_world_info`.
  */
 hairsim_error hairsim_get_info(struct hairsim_world *world, struct hairsim_world_info *out);
+
+/**
+ * What the last call on `world` that reached it did: its code (`HAIRSIM_ERROR_OK` when it
+ * succeeded) and, when it was refused, the function, the argument and field it refused and
+ * the element concerned. Every call on a world but this one records its outcome there,
+ * except a call refused because of the world argument itself (NULL, misaligned, not
+ * initialised, busy): that refusal cannot be kept in the world. Reading it changes nothing.
+ *
+ * # Safety
+ * `world` as for `hairsim_init`; `out`, if not NULL, valid for writes of a
+ * `hairsim_refusal`.
+ */
+hairsim_error hairsim_last_refusal(struct hairsim_world *world, struct hairsim_refusal *out);
 
 /**
  * The head's pose at time `t` (s) of `shake`, computed as the core computes it with the

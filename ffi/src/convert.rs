@@ -7,6 +7,7 @@ use hairsim_core::{
     Material, Math, Mode, ParamError, Params, Pose, Quat, Shake, Solver, StepReport, Vec3,
 };
 
+use crate::refusal::{core_field, Name, Refused};
 use crate::types::*;
 
 /// The effect bits and the core's effects, one to one.
@@ -41,19 +42,33 @@ const UNIT_QUAT_SLACK: f32 = 1.0e-3;
 /// Largest `| |a|^2 - 1 |` a shake axis may have (the core's own slack for unit vectors).
 const UNIT_AXIS_SLACK: f32 = 1.0e-4;
 
-pub(crate) type Result<T> = core::result::Result<T, hairsim_error>;
+pub(crate) type Result<T> = core::result::Result<T, Refused>;
 
-fn finite(values: &[f32]) -> Result<()> {
-    if values.iter().all(|v| v.is_finite()) {
-        Ok(())
-    } else {
-        Err(hairsim_error::NotFinite)
+/// `Ok` if every value is finite, else `HAIRSIM_ERROR_NOT_FINITE` naming the first that is
+/// not.
+fn finite(values: &[(f32, Name)]) -> Result<()> {
+    match values.iter().find(|(v, _)| !v.is_finite()) {
+        None => Ok(()),
+        Some(&(_, field)) => Err(Refused::from(hairsim_error::NotFinite).field(field)),
     }
 }
 
+/// `HAIRSIM_ERROR_OUT_OF_RANGE` about `field`.
+fn out_of_range(field: Name) -> Refused {
+    Refused::from(hairsim_error::OutOfRange).field(field)
+}
+
 pub(crate) fn vec3(v: hairsim_vec3) -> Result<Vec3> {
-    finite(&[v.x, v.y, v.z])?;
-    Ok(Vec3::new(v.x, v.y, v.z))
+    if v.x.is_finite() && v.y.is_finite() && v.z.is_finite() {
+        Ok(Vec3::new(v.x, v.y, v.z))
+    } else {
+        Err(hairsim_error::NotFinite.into())
+    }
+}
+
+/// [`vec3`], a refusal naming `field`.
+fn vec3_field(v: hairsim_vec3, field: Name) -> Result<Vec3> {
+    vec3(v).map_err(|r| r.field(field))
 }
 
 pub(crate) fn vec3_to_c(v: Vec3) -> hairsim_vec3 {
@@ -69,17 +84,19 @@ fn finite_result(v: Vec3) -> Result<Vec3> {
     if v.x.is_finite() && v.y.is_finite() && v.z.is_finite() {
         Ok(v)
     } else {
-        Err(hairsim_error::NotFinite)
+        Err(hairsim_error::NotFinite.into())
     }
 }
 
+/// A head pose (the field `head` of a step's input).
 pub(crate) fn pose(p: &hairsim_pose) -> Result<Pose> {
-    let position = vec3(p.position)?;
+    let position = vec3_field(p.position, Name::Head)?;
     let q = p.rotation;
-    finite(&[q.x, q.y, q.z, q.w])?;
+    let head = Name::Head;
+    finite(&[(q.x, head), (q.y, head), (q.z, head), (q.w, head)])?;
     let n2 = q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w;
     if (n2 - 1.0).abs() > UNIT_QUAT_SLACK {
-        return Err(hairsim_error::OutOfRange);
+        return Err(out_of_range(head));
     }
     Ok(Pose {
         position,
@@ -103,9 +120,13 @@ pub(crate) fn pose_to_c(p: &Pose) -> hairsim_pose {
 pub(crate) fn shake_pose(s: &hairsim_shake, t: f32) -> Result<hairsim_pose> {
     let axis = vec3(s.axis)?;
     let centre = vec3(s.centre)?;
-    finite(&[s.amplitude, s.frequency, t])?;
+    finite(&[
+        (s.amplitude, Name::None),
+        (s.frequency, Name::None),
+        (t, Name::None),
+    ])?;
     if (axis.length_squared() - 1.0).abs() > UNIT_AXIS_SLACK {
-        return Err(hairsim_error::OutOfRange);
+        return Err(hairsim_error::OutOfRange.into());
     }
     let shake = Shake {
         axis,
@@ -122,7 +143,11 @@ pub(crate) fn shake_pose(s: &hairsim_shake, t: f32) -> Result<hairsim_pose> {
 /// `scenes::firmware::grab_target` (checked bit for bit by a unit test).
 pub(crate) fn circle_target(c: &hairsim_circle, t: f32) -> Result<hairsim_vec3> {
     let start = vec3(c.start)?;
-    finite(&[c.radius, c.frequency, t])?;
+    finite(&[
+        (c.radius, Name::None),
+        (c.frequency, Name::None),
+        (t, Name::None),
+    ])?;
     let (s, cos) = DefaultMath::sin_cos(2.0 * core::f32::consts::PI * c.frequency * t);
     let target = start + Vec3::new(c.radius * (cos - 1.0), 0.0, c.radius * s);
     Ok(vec3_to_c(finite_result(target)?))
@@ -130,11 +155,11 @@ pub(crate) fn circle_target(c: &hairsim_circle, t: f32) -> Result<hairsim_vec3> 
 
 pub(crate) fn material(m: &hairsim_material) -> Result<Material> {
     finite(&[
-        m.youngs_modulus,
-        m.shear_modulus,
-        m.radius,
-        m.density,
-        m.minor_axis_penalty,
+        (m.youngs_modulus, Name::YoungsModulus),
+        (m.shear_modulus, Name::ShearModulus),
+        (m.radius, Name::Radius),
+        (m.density, Name::Density),
+        (m.minor_axis_penalty, Name::MinorAxisPenalty),
     ])?;
     Ok(Material {
         youngs_modulus: m.youngs_modulus,
@@ -169,7 +194,7 @@ fn set_twist(params: &mut Params, code: u32) -> Result<()> {
         .into_iter()
         .find(|&(c, _)| c == code)
         .map(|(_, name)| name)
-        .ok_or(hairsim_error::OutOfRange)?;
+        .ok_or(out_of_range(Name::RodTwist))?;
     let candidates = [
         Params::DEFAULT.rod.twist,
         hairsim_core::scenes::firmware::params().rod.twist,
@@ -177,7 +202,7 @@ fn set_twist(params: &mut Params, code: u32) -> Result<()> {
     params.rod.twist = candidates
         .into_iter()
         .find(|t| t.name() == name)
-        .ok_or(hairsim_error::OutOfRange)?;
+        .ok_or(out_of_range(Name::RodTwist))?;
     Ok(())
 }
 
@@ -194,43 +219,44 @@ fn twist_to_c(params: &Params) -> u32 {
 /// `World::configure`.
 pub(crate) fn params(p: &hairsim_params) -> Result<Params> {
     finite(&[
-        p.dt,
-        p.drag,
-        p.rod_projection_tolerance,
-        p.rod_newton_tolerance,
-        p.dftl_damping,
-        p.dftl_global_shape,
-        p.dftl_local_shape,
-        p.dftl_reference_dt,
-        p.dftl_global_shape_fade,
-        p.dftl_local_shape_fade,
-        p.wind_strength,
-        p.wind_gust,
-        p.wind_gust_frequency,
+        (p.dt, Name::Dt),
+        (p.drag, Name::Drag),
+        (p.rod_projection_tolerance, Name::RodProjectionTolerance),
+        (p.rod_newton_tolerance, Name::RodNewtonTolerance),
+        (p.dftl_damping, Name::DftlDamping),
+        (p.dftl_global_shape, Name::DftlGlobalShape),
+        (p.dftl_local_shape, Name::DftlLocalShape),
+        (p.dftl_reference_dt, Name::DftlReferenceDt),
+        (p.dftl_global_shape_fade, Name::DftlGlobalShapeFade),
+        (p.dftl_local_shape_fade, Name::DftlLocalShapeFade),
+        (p.wind_strength, Name::WindStrength),
+        (p.wind_gust, Name::WindGust),
+        (p.wind_gust_frequency, Name::WindGustFrequency),
     ])?;
     let mut params = Params::DEFAULT;
     params.solver = solver(p.solver)?;
     params.mode = match p.mode {
         x if x == hairsim_mode::Converge as u32 => Mode::Converge,
         x if x == hairsim_mode::FixedCost as u32 => Mode::FixedCost,
-        _ => return Err(hairsim_error::OutOfRange),
+        _ => return Err(out_of_range(Name::Mode)),
     };
     let known = EFFECTS.iter().fold(0, |bits, (bit, _)| bits | bit);
     if p.effects & !known != 0 {
-        return Err(hairsim_error::OutOfRange);
+        return Err(out_of_range(Name::Effects));
     }
     params.effects = EFFECTS
         .iter()
         .filter(|(bit, _)| p.effects & bit != 0)
         .fold(Effects::NONE, |set, &(_, effect)| set.with(effect));
     params.dt = p.dt;
-    params.gravity = vec3(p.gravity)?;
+    params.gravity = vec3_field(p.gravity, Name::Gravity)?;
     params.drag = p.drag;
-    let iterations = |n: u32| u16::try_from(n).map_err(|_| hairsim_error::OutOfRange);
-    params.rod.projection_iterations = iterations(p.rod_projection_iterations)?;
+    let iterations = |n: u32, field| u16::try_from(n).map_err(|_| out_of_range(field));
+    params.rod.projection_iterations =
+        iterations(p.rod_projection_iterations, Name::RodProjectionIterations)?;
     params.rod.projection_tolerance = p.rod_projection_tolerance;
     set_twist(&mut params, p.rod_twist)?;
-    params.rod.newton_iterations = iterations(p.rod_newton_iterations)?;
+    params.rod.newton_iterations = iterations(p.rod_newton_iterations, Name::RodNewtonIterations)?;
     params.rod.newton_tolerance = p.rod_newton_tolerance;
     params.dftl.damping = p.dftl_damping;
     params.dftl.global_shape = p.dftl_global_shape;
@@ -238,7 +264,7 @@ pub(crate) fn params(p: &hairsim_params) -> Result<Params> {
     params.dftl.reference_dt = p.dftl_reference_dt;
     params.dftl.global_shape_fade = p.dftl_global_shape_fade;
     params.dftl.local_shape_fade = p.dftl_local_shape_fade;
-    params.wind.direction = vec3(p.wind_direction)?;
+    params.wind.direction = vec3_field(p.wind_direction, Name::WindDirection)?;
     params.wind.strength = p.wind_strength;
     params.wind.gust = p.wind_gust;
     params.wind.gust_frequency = p.wind_gust_frequency;
@@ -251,7 +277,7 @@ pub(crate) fn solver(code: u32) -> Result<Solver> {
     match code {
         x if x == hairsim_solver::Rod as u32 => Ok(Solver::Rod),
         x if x == hairsim_solver::Dftl as u32 => Ok(Solver::Dftl),
-        _ => Err(hairsim_error::OutOfRange),
+        _ => Err(out_of_range(Name::Solver)),
     }
 }
 
@@ -292,9 +318,9 @@ pub(crate) fn params_to_c(p: &Params) -> hairsim_params {
 }
 
 pub(crate) fn collider(c: &hairsim_collider) -> Result<Collider> {
-    let a = vec3(c.a)?;
-    let b = vec3(c.b)?;
-    finite(&[c.radius])?;
+    let a = vec3_field(c.a, Name::A)?;
+    let b = vec3_field(c.b, Name::B)?;
+    finite(&[(c.radius, Name::Radius)])?;
     let shape = match c.shape {
         x if x == hairsim_shape::Sphere as u32 => Shape::Sphere {
             centre: a,
@@ -309,12 +335,12 @@ pub(crate) fn collider(c: &hairsim_collider) -> Result<Collider> {
             point: a,
             normal: b,
         },
-        _ => return Err(hairsim_error::OutOfRange),
+        _ => return Err(out_of_range(Name::Shape)),
     };
     let attached_to_head = match c.attached_to_head {
         0 => false,
         1 => true,
-        _ => return Err(hairsim_error::OutOfRange),
+        _ => return Err(out_of_range(Name::AttachedToHead)),
     };
     Ok(Collider {
         shape,
@@ -330,40 +356,67 @@ pub(crate) fn grab_status_to_c(status: GrabStatus) -> u32 {
     }
 }
 
-pub(crate) fn build_error(e: BuildError) -> hairsim_error {
+/// A strand's build error: its code, with the argument and the node or segment it names.
+pub(crate) fn build_error(e: BuildError) -> Refused {
+    let code = |code: hairsim_error, argument| Refused::from(code).argument(argument);
     match e {
-        BuildError::TooFewNodes { .. } => hairsim_error::TooFewNodes,
-        BuildError::TooManyNodes { .. } => hairsim_error::TooManyNodes,
-        BuildError::NonFiniteNode { .. } => hairsim_error::NotFinite,
-        BuildError::DegenerateSegment { .. } => hairsim_error::DegenerateSegment,
-        BuildError::FoldedSegment { .. } => hairsim_error::FoldedSegment,
-        BuildError::InvalidMaterial { .. } => hairsim_error::InvalidMaterial,
+        BuildError::TooFewNodes { .. } => code(hairsim_error::TooFewNodes, Name::Count),
+        BuildError::TooManyNodes { .. } => code(hairsim_error::TooManyNodes, Name::Count),
+        BuildError::NonFiniteNode { node } => code(hairsim_error::NotFinite, Name::Points).at(node),
+        BuildError::DegenerateSegment { segment } => {
+            code(hairsim_error::DegenerateSegment, Name::Points).at(segment)
+        }
+        BuildError::LongSegment { segment } => {
+            code(hairsim_error::LongSegment, Name::Points).at(segment)
+        }
+        BuildError::FoldedSegment { node } => {
+            code(hairsim_error::FoldedSegment, Name::Points).at(node)
+        }
+        BuildError::InvalidMaterial { field, .. } => {
+            code(hairsim_error::InvalidMaterial, Name::Material).field(core_field(field))
+        }
     }
 }
 
-pub(crate) fn capacity_error(e: CapacityError) -> hairsim_error {
-    match e {
+pub(crate) fn capacity_error(e: CapacityError) -> Refused {
+    Refused::from(match e {
         CapacityError::Strands { .. } => hairsim_error::StrandsFull,
         CapacityError::Colliders { .. } => hairsim_error::CollidersFull,
         CapacityError::Grabs { .. } => hairsim_error::GrabsFull,
-    }
+    })
 }
 
-pub(crate) fn param_error(e: ParamError) -> hairsim_error {
+/// A parameter error: its code and the field it names (for an effect, `effects` and the
+/// effect's bit).
+pub(crate) fn param_error(e: ParamError) -> Refused {
+    let effect_bit = |name: &str| {
+        EFFECTS
+            .iter()
+            .position(|(_, effect)| effect.name() == name)
+            .unwrap_or(usize::MAX)
+    };
     match e {
-        ParamError::OutOfRange { .. } => hairsim_error::OutOfRange,
-        ParamError::UnsupportedEffect { .. } => hairsim_error::UnsupportedEffect,
-        ParamError::EffectOff { .. } => hairsim_error::EffectOff,
+        ParamError::OutOfRange { field, .. } => out_of_range(core_field(field)),
+        ParamError::UnsupportedEffect { effect, .. } => {
+            Refused::from(hairsim_error::UnsupportedEffect)
+                .field(Name::Effects)
+                .at(effect_bit(effect))
+        }
+        ParamError::EffectOff { effect, .. } => Refused::from(hairsim_error::EffectOff)
+            .field(Name::Effects)
+            .at(effect_bit(effect)),
     }
 }
 
-/// An error of `add_collider` or `add_grab`: a refused value is `invalid`.
-pub(crate) fn add_error(e: Error, invalid: hairsim_error) -> hairsim_error {
+/// An error of `add_collider` or `add_grab`: a refused value is `invalid`, naming its field.
+pub(crate) fn add_error(e: Error, invalid: hairsim_error) -> Refused {
     match e {
         Error::Build(e) => build_error(e),
         Error::Capacity(e) => capacity_error(e),
-        Error::Param(e @ ParamError::EffectOff { .. }) => param_error(e),
-        Error::Param(_) => invalid,
+        Error::Param(ParamError::OutOfRange { field, .. }) => {
+            Refused::from(invalid).field(core_field(field))
+        }
+        Error::Param(e) => param_error(e),
     }
 }
 

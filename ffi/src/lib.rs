@@ -34,6 +34,7 @@
 extern crate std;
 
 mod convert;
+mod refusal;
 pub mod types;
 
 #[cfg(test)]
@@ -51,6 +52,7 @@ use hairsim_core::{
 };
 
 use convert::Result;
+use refusal::{Function, Name, Record, Refused};
 pub use types::*;
 
 /// The build-time capacities (`build.rs`).
@@ -89,6 +91,9 @@ const BUSY: u32 = 0x4841_4972;
 pub(crate) struct CellOf<const S: usize, const N: usize> {
     /// `IDLE`, `BUSY`, or anything else before `hairsim_init`.
     state: AtomicU32,
+    /// The outcome of the last call on the world (`hairsim_last_refusal`); only reached
+    /// through a [`Lease`].
+    record: Record,
     /// The world; only reached through a [`Lease`].
     world: World<S, N, DefaultMath>,
 }
@@ -106,6 +111,8 @@ pub(crate) const WORLD_ALIGN: usize = align_of::<Cell>();
 struct Lease<'a> {
     state: &'a AtomicU32,
     world: &'a mut SimWorld,
+    /// The world's record of its last call's outcome.
+    record: &'a mut Record,
 }
 
 impl Drop for Lease<'_> {
@@ -114,29 +121,39 @@ impl Drop for Lease<'_> {
     }
 }
 
-/// Checks that `p` is non-NULL and aligned for `T`.
-fn check_ptr<T>(p: *const T) -> Result<()> {
+/// `code` about `argument`.
+fn refused(code: hairsim_error, argument: Name) -> Refused {
+    Refused::from(code).argument(argument)
+}
+
+/// Checks that `p` (the argument `argument`) is non-NULL and aligned for `T`.
+fn check_ptr<T>(p: *const T, argument: Name) -> Result<()> {
     if p.is_null() {
-        Err(hairsim_error::NullPointer)
+        Err(refused(hairsim_error::NullPointer, argument))
     } else if !p.is_aligned() {
-        Err(hairsim_error::Misaligned)
+        Err(refused(hairsim_error::Misaligned, argument))
     } else {
         Ok(())
     }
 }
 
 /// Checks an optional pointer: NULL, or aligned for `T`.
-fn check_optional<T>(p: *const T) -> Result<()> {
+fn check_optional<T>(p: *const T, argument: Name) -> Result<()> {
     if p.is_null() || p.is_aligned() {
         Ok(())
     } else {
-        Err(hairsim_error::Misaligned)
+        Err(refused(hairsim_error::Misaligned, argument))
     }
 }
 
 /// Checks that `count` `T`s at `p` do not overlap the world's buffer: the world is borrowed
 /// mutably while they are read or written.
-fn check_disjoint<T>(p: *const T, count: usize, world: *const hairsim_world) -> Result<()> {
+fn check_disjoint<T>(
+    p: *const T,
+    count: usize,
+    world: *const hairsim_world,
+    argument: Name,
+) -> Result<()> {
     if p.is_null() || count == 0 {
         return Ok(());
     }
@@ -145,75 +162,76 @@ fn check_disjoint<T>(p: *const T, count: usize, world: *const hairsim_world) -> 
     let world_start = world as usize;
     let world_end = world_start.saturating_add(WORLD_SIZE);
     if start < world_end && world_start < end {
-        Err(hairsim_error::Overlap)
+        Err(refused(hairsim_error::Overlap, argument))
     } else {
         Ok(())
     }
 }
 
-/// Copies the `T` at `p` out of the caller's memory.
+/// Copies the `T` at `p` (the argument `argument`) out of the caller's memory.
 ///
 /// # Safety
 /// `p`, if not NULL, must be valid for reads of a `T`, and `T` must be plain data for which
 /// every bit pattern is a valid value.
-unsafe fn read<T: Copy>(p: *const T) -> Result<T> {
-    check_ptr(p)?;
+unsafe fn read<T: Copy>(p: *const T, argument: Name) -> Result<T> {
+    check_ptr(p, argument)?;
     // SAFETY: `p` is non-NULL and aligned (checked), valid for reads of a `T` (the caller's
     // promise), and every `T` used here is a `#[repr(C)]` struct of integers, floats and raw
     // pointers: every bit pattern is a valid value.
     Ok(unsafe { ptr::read(p) })
 }
 
-/// Writes `value` to `p`.
+/// Writes `value` to `p` (the argument `argument`).
 ///
 /// # Safety
 /// `p`, if not NULL, must be valid for writes of a `T`.
-unsafe fn write<T>(p: *mut T, value: T) -> Result<()> {
-    check_ptr(p)?;
+unsafe fn write<T>(p: *mut T, value: T, argument: Name) -> Result<()> {
+    check_ptr(p, argument)?;
     // SAFETY: `p` is non-NULL and aligned (checked) and valid for writes of a `T` (the
     // caller's promise); `T` is plain data with no destructor: nothing is dropped.
     unsafe { ptr::write(p, value) };
     Ok(())
 }
 
-/// Writes `value` to `p` if `p` is not NULL (an optional output).
+/// Writes `value` to `p` if `p` is not NULL (an optional output, checked beforehand).
 ///
 /// # Safety
 /// `p`, if not NULL, must be valid for writes of a `T`.
-unsafe fn write_optional<T>(p: *mut T, value: T) -> Result<()> {
+unsafe fn write_optional<T>(p: *mut T, value: T, argument: Name) -> Result<()> {
     if p.is_null() {
         return Ok(());
     }
     // SAFETY: the caller's promise for a non-NULL `p`.
-    unsafe { write(p, value) }
+    unsafe { write(p, value, argument) }
 }
 
-/// The caller's array `(p, count)` as a slice, after checking the pointer; `count` 0 accepts
-/// NULL. `count` must already be bounded by a capacity, so that `count * size_of::<T>()` is
-/// far below `isize::MAX`.
+/// The caller's array `(p, count)` (the argument `argument`) as a slice, after checking the
+/// pointer; `count` 0 accepts NULL. `count` must already be bounded by a capacity, so that
+/// `count * size_of::<T>()` is far below `isize::MAX`.
 ///
 /// # Safety
 /// `p`, if not NULL, must be valid for reads of `count` `T`s that nothing writes while the
 /// slice lives, and every bit pattern of `T` must be a valid value.
-unsafe fn slice<'a, T>(p: *const T, count: usize) -> Result<&'a [T]> {
+unsafe fn slice<'a, T>(p: *const T, count: usize, argument: Name) -> Result<&'a [T]> {
     if count == 0 {
         return Ok(&[]);
     }
-    check_ptr(p)?;
+    check_ptr(p, argument)?;
     // SAFETY: `p` is non-NULL and aligned (checked) and valid for reads of `count` elements
     // nothing writes meanwhile (the caller's promise); `count` is bounded by a capacity, so
     // the slice is far smaller than `isize::MAX` bytes; every bit pattern of `T` is valid.
     Ok(unsafe { core::slice::from_raw_parts(p, count) })
 }
 
-/// Takes exclusive use of an initialised world.
+/// Takes exclusive use of an initialised world. A refusal here is about the argument
+/// `world`, and nothing can be recorded in it.
 ///
 /// # Safety
 /// `world`, if not NULL, must be valid for reads and writes of `HAIRSIM_WORLD_SIZE` bytes for
 /// the length of the call.
 unsafe fn lease<'a>(world: *mut hairsim_world) -> Result<Lease<'a>> {
     let cell = world.cast::<Cell>();
-    check_ptr(cell)?;
+    check_ptr(cell, Name::World)?;
     // SAFETY: `cell` is non-NULL and aligned for `Cell` (checked) and the buffer is valid for
     // `size_of::<Cell>()` bytes (the caller's promise), so its first field is a valid
     // `AtomicU32` place: any bit pattern is a `u32`. It is only ever accessed atomically, here
@@ -221,34 +239,63 @@ unsafe fn lease<'a>(world: *mut hairsim_world) -> Result<Lease<'a>> {
     let state = unsafe { &*addr_of!((*cell).state) };
     match state.compare_exchange(IDLE, BUSY, Ordering::Acquire, Ordering::Relaxed) {
         Ok(_) => {}
-        Err(BUSY) => return Err(hairsim_error::Busy),
-        Err(_) => return Err(hairsim_error::NotInitialised),
+        Err(BUSY) => return Err(refused(hairsim_error::Busy, Name::World)),
+        Err(_) => return Err(refused(hairsim_error::NotInitialised, Name::World)),
     }
-    // SAFETY: the state word was `IDLE`, so `hairsim_init` wrote a valid world after it, and
-    // this call swapped it to `BUSY`: every other call refuses until the lease is dropped, so
-    // this is the only reference to the world (a field disjoint from the state word), and the
-    // caller's other buffers were checked not to overlap it.
-    let world = unsafe { &mut *addr_of_mut!((*cell).world) };
-    Ok(Lease { state, world })
+    // SAFETY: the state word was `IDLE`, so `hairsim_init` wrote a valid world and record
+    // after it, and this call swapped it to `BUSY`: every other call refuses until the lease
+    // is dropped, so these are the only references to them (fields disjoint from the state
+    // word and from each other), and the caller's other buffers were checked not to overlap
+    // them. A record is integers only: any bytes are one.
+    let (world, record) = unsafe {
+        (
+            &mut *addr_of_mut!((*cell).world),
+            &mut *addr_of_mut!((*cell).record),
+        )
+    };
+    Ok(Lease {
+        state,
+        world,
+        record,
+    })
 }
 
-/// Runs `f` on the world under a lease.
+/// Runs `f` on the world under a lease, and records the outcome of `function` in the world
+/// (unless the world itself is refused).
 ///
 /// # Safety
 /// As [`lease`].
 unsafe fn with_world<T>(
     world: *mut hairsim_world,
+    function: Function,
     f: impl FnOnce(&mut SimWorld) -> Result<T>,
 ) -> Result<T> {
     // SAFETY: the caller's promise is `lease`'s.
     let lease = unsafe { lease(world) }?;
-    f(lease.world)
+    let result = f(lease.world);
+    *lease.record = Record::of(function, result.as_ref().err().copied());
+    result
+}
+
+/// Refuses a call of `function` before it reached the world: records why in the world, if
+/// the world can be taken, and returns the code.
+///
+/// # Safety
+/// As [`lease`].
+unsafe fn refuse(world: *mut hairsim_world, function: Function, why: Refused) -> hairsim_error {
+    if why.argument != Name::World {
+        // SAFETY: the caller's promise is `lease`'s.
+        if let Ok(lease) = unsafe { lease(world) } {
+            *lease.record = Record::of(function, Some(why));
+        }
+    }
+    why.code
 }
 
 fn code(r: Result<()>) -> hairsim_error {
     match r {
         Ok(()) => hairsim_error::Ok,
-        Err(e) => e,
+        Err(e) => e.code,
     }
 }
 
@@ -263,11 +310,11 @@ fn check_header(version: u32, strands: u32, nodes: u32) -> Result<()> {
         minor <= HAIRSIM_VERSION_MINOR
     };
     if major != HAIRSIM_VERSION_MAJOR || !minor_works {
-        Err(hairsim_error::VersionMismatch)
+        Err(hairsim_error::VersionMismatch.into())
     } else if strands as usize != STRANDS {
-        Err(hairsim_error::StrandsMismatch)
+        Err(hairsim_error::StrandsMismatch.into())
     } else if nodes as usize != NODES {
-        Err(hairsim_error::NodesMismatch)
+        Err(hairsim_error::NodesMismatch.into())
     } else {
         Ok(())
     }
@@ -306,7 +353,7 @@ pub unsafe extern "C" fn hairsim_init_versioned(
     nodes: u32,
 ) -> hairsim_error {
     if let Err(e) = check_header(version, strands, nodes) {
-        return e;
+        return e.code;
     }
     // SAFETY: the caller's promise.
     unsafe { init(buffer, len) }
@@ -331,8 +378,8 @@ pub unsafe fn hairsim_init(buffer: *mut hairsim_world, len: usize) -> hairsim_er
 #[inline(always)]
 unsafe fn init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
     let cell = buffer.cast::<Cell>();
-    if let Err(e) = check_ptr(cell) {
-        return e;
+    if let Err(e) = check_ptr(cell, Name::World) {
+        return e.code;
     }
     if len < size_of::<Cell>() {
         return hairsim_error::BufferTooSmall;
@@ -366,6 +413,8 @@ unsafe fn init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
     // default parameters, not on the stack (`.ci/ffi` checks `hairsim_init`'s frame in the
     // thumbv7em disassembly); a `const` empty world would be a world-sized copy from flash.
     unsafe { ptr::write(addr_of_mut!((*cell).world), SimWorld::new()) };
+    // SAFETY: as the world's, for the record.
+    unsafe { ptr::write(addr_of_mut!((*cell).record), Record::NONE) };
     state.store(IDLE, Ordering::Release);
     hairsim_error::Ok
 }
@@ -388,10 +437,10 @@ pub unsafe extern "C" fn hairsim_params_preset(
 ) -> hairsim_error {
     let preset = match convert::solver(solver) {
         Ok(solver) => Params::preset(solver),
-        Err(e) => return e,
+        Err(e) => return e.code,
     };
     // SAFETY: the caller's promise.
-    code(unsafe { write(out, convert::params_to_c(&preset)) })
+    code(unsafe { write(out, convert::params_to_c(&preset), Name::Out) })
 }
 
 /// Fills `out` with the parameters `hairsim_init` gives a world: the rod's preset,
@@ -403,7 +452,7 @@ pub unsafe extern "C" fn hairsim_params_preset(
 #[no_mangle]
 pub unsafe extern "C" fn hairsim_params_default(out: *mut hairsim_params) -> hairsim_error {
     // SAFETY: the caller's promise.
-    code(unsafe { write(out, convert::params_to_c(&Params::DEFAULT)) })
+    code(unsafe { write(out, convert::params_to_c(&Params::DEFAULT), Name::Out) })
 }
 
 /// Fills `out` with a human hair: E = 3.5 GPa, G = 1.3 GPa, r = 40 um, 1300 kg/m^3.
@@ -413,7 +462,13 @@ pub unsafe extern "C" fn hairsim_params_default(out: *mut hairsim_params) -> hai
 #[no_mangle]
 pub unsafe extern "C" fn hairsim_material_human_hair(out: *mut hairsim_material) -> hairsim_error {
     // SAFETY: the caller's promise.
-    code(unsafe { write(out, convert::material_to_c(&Material::HUMAN_HAIR)) })
+    code(unsafe {
+        write(
+            out,
+            convert::material_to_c(&Material::HUMAN_HAIR),
+            Name::Out,
+        )
+    })
 }
 
 /// Sets the world's parameters and effects (the time step included), after checking every
@@ -427,21 +482,42 @@ pub unsafe extern "C" fn hairsim_configure(
     world: *mut hairsim_world,
     params: *const hairsim_params,
 ) -> hairsim_error {
-    if let Err(e) = check_disjoint(params, 1, world) {
-        return e;
-    }
+    const F: Function = Function::Configure;
     // SAFETY: the caller's promise for `params`; it is copied before the world is borrowed.
-    let params = match unsafe { read(params) }.and_then(|p| convert::params(&p)) {
+    let checked = check_disjoint(params, 1, world, Name::Params)
+        .and_then(|()| unsafe { read(params, Name::Params) })
+        .and_then(|p| convert::params(&p).map_err(|r| r.argument(Name::Params)));
+    let params = match checked {
         Ok(p) => p,
-        Err(e) => return e,
+        // SAFETY: the caller's promise for `world`.
+        Err(why) => return unsafe { refuse(world, F, why) },
     };
-    let configure = |w: &mut SimWorld| w.configure(params).map_err(convert::param_error);
+    let configure = |w: &mut SimWorld| {
+        w.configure(params)
+            .map_err(|e| convert::param_error(e).argument(Name::Params))
+    };
     // SAFETY: the caller's promise for `world`.
-    code(unsafe { with_world(world, configure) })
+    code(unsafe { with_world(world, F, configure) })
+}
+
+/// Copies the caller's polyline `points[0 .. count)` (`count` at most `NODES`, checked).
+///
+/// # Safety
+/// `points`, if not NULL, valid for reads of `count` `hairsim_vec3`.
+unsafe fn polyline(points: *const hairsim_vec3, count: usize) -> Result<[Vec3; NODES]> {
+    let mut polyline = [Vec3::ZERO; NODES];
+    // SAFETY: the caller's promise; `count <= NODES`.
+    let given = unsafe { slice(points, count, Name::Points) }?;
+    for (p, c) in polyline.iter_mut().zip(given) {
+        *p = Vec3::new(c.x, c.y, c.z);
+    }
+    Ok(polyline)
 }
 
 /// Adds a strand at rest along the polyline `points[0 .. count)` (root first, in the head's
-/// frame, 3 to `HAIRSIM_NODES` points), of `material`. Its index goes to `index` if not NULL.
+/// frame, 3 to `HAIRSIM_NODES` points, each segment from 1e-6 m to 1 m long), of `material`.
+/// Its index goes to `index` if not NULL. A refused point or segment is named by
+/// `hairsim_last_refusal` (argument `points`, its index).
 ///
 /// # Safety
 /// `world` as for `hairsim_init`; `points`, if not NULL, valid for reads of `count`
@@ -455,46 +531,42 @@ pub unsafe extern "C" fn hairsim_add_strand(
     material: *const hairsim_material,
     index: *mut u32,
 ) -> hairsim_error {
-    if count > NODES {
-        return hairsim_error::TooManyNodes;
+    const F: Function = Function::AddStrand;
+    let checked = if count > NODES {
+        Err(refused(hairsim_error::TooManyNodes, Name::Count))
+    } else {
+        check_disjoint(material, 1, world, Name::Material)
+            .and(check_disjoint(points, count, world, Name::Points))
+            .and(check_optional(index, Name::Index))
+            .and(check_disjoint(index, 1, world, Name::Index))
     }
-    let checks = check_disjoint(material, 1, world)
-        .and(check_disjoint(points, count, world))
-        .and(check_optional(index))
-        .and(check_disjoint(index, 1, world));
-    if let Err(e) = checks {
-        return e;
-    }
-    // SAFETY: the caller's promise for `material`; it is copied before the world is borrowed.
-    let material = match unsafe { read(material) }.and_then(|m| convert::material(&m)) {
-        Ok(m) => m,
-        Err(e) => return e,
+    // SAFETY: the caller's promises for `material` and `points`; `count <= NODES` (checked).
+    // Both are copied before the world is borrowed.
+    .and_then(|()| unsafe { read(material, Name::Material) })
+    .and_then(|m| convert::material(&m).map_err(|r| r.argument(Name::Material)))
+    // SAFETY: the caller's promise for `points`; `count <= NODES` (checked).
+    .and_then(|m| Ok((m, unsafe { polyline(points, count) }?)));
+    let (material, polyline) = match checked {
+        Ok(c) => c,
+        // SAFETY: the caller's promise for `world`.
+        Err(why) => return unsafe { refuse(world, F, why) },
     };
-    let mut polyline = [Vec3::ZERO; NODES];
-    // SAFETY: the caller's promise for `points`; `count <= NODES` (checked). The points are
-    // copied before the world is borrowed.
-    match unsafe { slice(points, count) } {
-        Ok(points) => {
-            for (p, c) in polyline.iter_mut().zip(points) {
-                *p = Vec3::new(c.x, c.y, c.z);
-            }
-        }
-        Err(e) => return e,
-    }
     let add = |w: &mut SimWorld| {
         let strand = Strand::<NODES>::from_polyline(&polyline[..count], &material)
             .map_err(convert::build_error)?;
         w.add_strand(strand).map_err(convert::capacity_error)
     };
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, add) } {
-        // SAFETY: the caller's promise for `index` (the world is no longer borrowed).
-        Ok(i) => code(unsafe { write_optional(index, i as u32) }),
-        Err(e) => e,
+    match unsafe { with_world(world, F, add) } {
+        // SAFETY: the caller's promise for `index` (checked; the world is no
+        // longer borrowed).
+        Ok(i) => code(unsafe { write_optional(index, i as u32, Name::Index) }),
+        Err(e) => e.code,
     }
 }
 
-/// Adds a collider (at most `HAIRSIM_MAX_COLLIDERS`). Its index goes to `index` if not NULL.
+/// Adds a collider (at most `HAIRSIM_MAX_COLLIDERS`; `HAIRSIM_EFFECT_COLLISIONS` must be on).
+/// Its index goes to `index` if not NULL.
 ///
 /// # Safety
 /// `world` as for `hairsim_init`; `collider`, if not NULL, valid for reads of a
@@ -505,31 +577,35 @@ pub unsafe extern "C" fn hairsim_add_collider(
     collider: *const hairsim_collider,
     index: *mut u32,
 ) -> hairsim_error {
-    let checks = check_disjoint(collider, 1, world)
-        .and(check_optional(index))
-        .and(check_disjoint(index, 1, world));
-    if let Err(e) = checks {
-        return e;
-    }
-    // SAFETY: the caller's promise for `collider`; it is copied before the world is borrowed.
-    let collider = match unsafe { read(collider) }.and_then(|c| convert::collider(&c)) {
+    const F: Function = Function::AddCollider;
+    let checked = check_disjoint(collider, 1, world, Name::Collider)
+        .and(check_optional(index, Name::Index))
+        .and(check_disjoint(index, 1, world, Name::Index))
+        // SAFETY: the caller's promise for `collider`; it is copied before the world is
+        // borrowed.
+        .and_then(|()| unsafe { read(collider, Name::Collider) })
+        .and_then(|c| convert::collider(&c).map_err(|r| r.argument(Name::Collider)));
+    let collider = match checked {
         Ok(c) => c,
-        Err(e) => return e,
+        // SAFETY: the caller's promise for `world`.
+        Err(why) => return unsafe { refuse(world, F, why) },
     };
     let add = |w: &mut SimWorld| {
-        w.add_collider(collider)
-            .map_err(|e| convert::add_error(e, hairsim_error::InvalidCollider))
+        w.add_collider(collider).map_err(|e| {
+            convert::add_error(e, hairsim_error::InvalidCollider).argument(Name::Collider)
+        })
     };
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, add) } {
-        // SAFETY: the caller's promise for `index` (the world is no longer borrowed).
-        Ok(i) => code(unsafe { write_optional(index, i as u32) }),
-        Err(e) => e,
+    match unsafe { with_world(world, F, add) } {
+        // SAFETY: the caller's promise for `index` (checked; the world is no
+        // longer borrowed).
+        Ok(i) => code(unsafe { write_optional(index, i as u32, Name::Index) }),
+        Err(e) => e.code,
     }
 }
 
-/// Adds a grab (at most `HAIRSIM_MAX_GRABS`) on a strand already added. Its index goes to
-/// `index` if not NULL.
+/// Adds a grab (at most `HAIRSIM_MAX_GRABS`; `HAIRSIM_EFFECT_GRABS` must be on) on a strand
+/// already added. Its index goes to `index` if not NULL.
 ///
 /// # Safety
 /// `world` as for `hairsim_init`; `grab`, if not NULL, valid for reads of a `hairsim_grab`;
@@ -540,39 +616,47 @@ pub unsafe extern "C" fn hairsim_add_grab(
     grab: *const hairsim_grab,
     index: *mut u32,
 ) -> hairsim_error {
-    let checks = check_disjoint(grab, 1, world)
-        .and(check_optional(index))
-        .and(check_disjoint(index, 1, world));
-    if let Err(e) = checks {
-        return e;
-    }
-    // SAFETY: the caller's promise for `grab`; it is copied before the world is borrowed.
-    let grab = match unsafe { read(grab) } {
+    const F: Function = Function::AddGrab;
+    let not_finite = |field| refused(hairsim_error::NotFinite, Name::Grab).field(field);
+    let checked = check_disjoint(grab, 1, world, Name::Grab)
+        .and(check_optional(index, Name::Index))
+        .and(check_disjoint(index, 1, world, Name::Index))
+        // SAFETY: the caller's promise for `grab`; it is copied before the world is borrowed.
+        .and_then(|()| unsafe { read(grab, Name::Grab) })
+        .and_then(|g| {
+            let target = convert::vec3(g.target).map_err(|_| not_finite(Name::Target))?;
+            let finite = [
+                (g.force_limit, Name::ForceLimit),
+                (g.stiffness, Name::Stiffness),
+                (g.damping, Name::Damping),
+            ];
+            if let Some(&(_, field)) = finite.iter().find(|(value, _)| !value.is_finite()) {
+                return Err(not_finite(field));
+            }
+            let held = Grab::new(g.strand, g.node, target, g.force_limit);
+            // Both zero: prescribed at the target; anything else is a coupling, in range or
+            // refused by the core (naming the field).
+            Ok(if g.stiffness == 0.0 && g.damping == 0.0 {
+                held
+            } else {
+                held.with_coupling(Coupling::new(g.stiffness, g.damping))
+            })
+        });
+    let grab = match checked {
         Ok(g) => g,
-        Err(e) => return e,
-    };
-    let target = match convert::vec3(grab.target) {
-        Ok(t) => t,
-        Err(e) => return e,
-    };
-    if !(grab.force_limit.is_finite() && grab.stiffness.is_finite() && grab.damping.is_finite()) {
-        return hairsim_error::NotFinite;
-    }
-    let held = Grab::new(grab.strand, grab.node, target, grab.force_limit);
-    let held = if grab.stiffness == 0.0 && grab.damping == 0.0 {
-        held
-    } else {
-        held.with_coupling(Coupling::new(grab.stiffness, grab.damping))
+        // SAFETY: the caller's promise for `world`.
+        Err(why) => return unsafe { refuse(world, F, why) },
     };
     let add = |w: &mut SimWorld| {
-        w.add_grab(held)
-            .map_err(|e| convert::add_error(e, hairsim_error::InvalidGrab))
+        w.add_grab(grab)
+            .map_err(|e| convert::add_error(e, hairsim_error::InvalidGrab).argument(Name::Grab))
     };
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, add) } {
-        // SAFETY: the caller's promise for `index` (the world is no longer borrowed).
-        Ok(i) => code(unsafe { write_optional(index, i as u32) }),
-        Err(e) => e,
+    match unsafe { with_world(world, F, add) } {
+        // SAFETY: the caller's promise for `index` (checked; the world is no
+        // longer borrowed).
+        Ok(i) => code(unsafe { write_optional(index, i as u32, Name::Index) }),
+        Err(e) => e.code,
     }
 }
 
@@ -587,30 +671,90 @@ pub unsafe extern "C" fn hairsim_release_grab(
 ) -> hairsim_error {
     let release = |w: &mut SimWorld| {
         if grab as usize >= w.grabs().len() {
-            return Err(hairsim_error::OutOfRange);
+            return Err(refused(hairsim_error::OutOfRange, Name::Grab));
         }
         w.release_grab(grab as usize);
         Ok(())
     };
     // SAFETY: the caller's promise for `world`.
-    code(unsafe { with_world(world, release) })
+    code(unsafe { with_world(world, Function::ReleaseGrab, release) })
 }
 
-/// A step with caller accelerations (checked finite), copied into the core's vectors in a
-/// frame of its own, so that a step without them does not pay for the buffer.
-#[inline(never)]
-fn step_with_accelerations(
-    world: &mut SimWorld,
+/// What a step takes from its input, checked and copied out of the caller's memory: the head
+/// pose, the grab targets and the accelerations (the caller's array, whose layout is the
+/// core's `Vec3`'s).
+struct Checked<'a> {
     head: hairsim_core::Pose,
-    accelerations: &[hairsim_vec3],
-) -> hairsim_core::StepReport {
-    let mut buffer = [Vec3::ZERO; STRANDS * NODES];
-    for (a, c) in buffer.iter_mut().zip(accelerations) {
-        *a = Vec3::new(c.x, c.y, c.z);
+    targets: [Vec3; HAIRSIM_MAX_GRABS],
+    target_count: usize,
+    accelerations: &'a [Vec3],
+}
+
+// `hairsim_vec3` and glam's `Vec3` (without SIMD) are both three `f32`s in a `repr(C)` struct.
+const _: () = assert!(size_of::<hairsim_vec3>() == size_of::<Vec3>());
+const _: () = assert!(align_of::<hairsim_vec3>() == align_of::<Vec3>());
+
+/// Checks a step's input and its arrays.
+///
+/// # Safety
+/// As `hairsim_step` for `input` and `report`.
+unsafe fn step_input<'a>(
+    world: *mut hairsim_world,
+    input: *const hairsim_step_input,
+    report: *mut hairsim_step_report,
+) -> Result<Checked<'a>> {
+    let arg = |r: Refused| r.argument(Name::Input);
+    check_disjoint(input, 1, world, Name::Input)?;
+    // SAFETY: the caller's promise for `input`; it is copied before the world is borrowed.
+    let input = unsafe { read(input, Name::Input) }?;
+    let head = convert::pose(&input.head).map_err(arg)?;
+    let (target_count, acceleration_count) = (input.grab_target_count, input.acceleration_count);
+    if target_count > HAIRSIM_MAX_GRABS {
+        return Err(arg(
+            Refused::from(hairsim_error::OutOfRange).field(Name::GrabTargetCount)
+        ));
     }
-    world.step(&StepInput {
+    if acceleration_count > STRANDS * NODES {
+        let too_many = Refused::from(hairsim_error::OutOfRange).field(Name::AccelerationCount);
+        return Err(arg(too_many));
+    }
+    check_optional(report, Name::Report)?;
+    check_disjoint(report, 1, world, Name::Report)?;
+    let field = |name: Name| move |r: Refused| arg(r.field(name));
+    check_disjoint(input.grab_targets, target_count, world, Name::Input)
+        .map_err(field(Name::GrabTargets))?;
+    check_disjoint(input.accelerations, acceleration_count, world, Name::Input)
+        .map_err(field(Name::Accelerations))?;
+    let mut targets = [Vec3::ZERO; HAIRSIM_MAX_GRABS];
+    // SAFETY: the caller's promise for the targets; the count is bounded (checked).
+    let given = unsafe { slice(input.grab_targets, target_count, Name::Input) }
+        .map_err(field(Name::GrabTargets))?;
+    for (k, (t, c)) in targets.iter_mut().zip(given).enumerate() {
+        *t = convert::vec3(*c).map_err(|r| field(Name::GrabTargets)(r).at(k))?;
+    }
+    // SAFETY: the caller's promise for the accelerations; the count is bounded (checked), and
+    // they do not overlap the world (checked), which is borrowed while they are read. Their
+    // layout is `Vec3`'s (asserted above), and every bit pattern is an `f32`.
+    let accelerations: &[Vec3] = unsafe {
+        slice(
+            input.accelerations.cast::<Vec3>(),
+            acceleration_count,
+            Name::Input,
+        )
+        .map_err(field(Name::Accelerations))?
+    };
+    if let Some(k) = accelerations
+        .iter()
+        .position(|a| !hairsim_core::math::is_finite(*a))
+    {
+        let not_finite = Refused::from(hairsim_error::NotFinite);
+        return Err(field(Name::Accelerations)(not_finite).at(k));
+    }
+    Ok(Checked {
         head,
-        accelerations: buffer.get(..accelerations.len()),
+        targets,
+        target_count,
+        accelerations,
     })
 }
 
@@ -618,7 +762,7 @@ fn step_with_accelerations(
 /// moves the head to `input->head` and steps every strand. The report goes to `report` if not
 /// NULL. A non-finite or non-unit pose, a non-finite target or acceleration, more targets than
 /// grabs or more accelerations than `HAIRSIM_STRANDS * HAIRSIM_NODES` are refused before
-/// anything changes.
+/// anything changes (`hairsim_last_refusal` names the field and the element).
 ///
 /// # Safety
 /// `world` as for `hairsim_init`; `input`, if not NULL, valid for reads of a
@@ -630,77 +774,33 @@ pub unsafe extern "C" fn hairsim_step(
     input: *const hairsim_step_input,
     report: *mut hairsim_step_report,
 ) -> hairsim_error {
-    if let Err(e) = check_disjoint(input, 1, world) {
-        return e;
-    }
-    // SAFETY: the caller's promise for `input`; it is copied before the world is borrowed.
-    let input = match unsafe { read(input) } {
-        Ok(i) => i,
-        Err(e) => return e,
+    const F: Function = Function::Step;
+    // SAFETY: the caller's promises for `input` and `report`.
+    let checked = match unsafe { step_input(world, input, report) } {
+        Ok(c) => c,
+        // SAFETY: the caller's promise for `world`.
+        Err(why) => return unsafe { refuse(world, F, why) },
     };
-    let head = match convert::pose(&input.head) {
-        Ok(h) => h,
-        Err(e) => return e,
-    };
-    let (grab_count, acceleration_count) = (input.grab_target_count, input.acceleration_count);
-    if grab_count > HAIRSIM_MAX_GRABS || acceleration_count > STRANDS * NODES {
-        return hairsim_error::OutOfRange;
-    }
-    let checks = check_optional(report)
-        .and(check_disjoint(report, 1, world))
-        .and(check_disjoint(input.grab_targets, grab_count, world))
-        .and(check_disjoint(
-            input.accelerations,
-            acceleration_count,
-            world,
-        ));
-    if let Err(e) = checks {
-        return e;
-    }
-    let mut targets = [Vec3::ZERO; HAIRSIM_MAX_GRABS];
-    // SAFETY: the caller's promise for the targets; the count is bounded (checked). They are
-    // copied before the world is borrowed.
-    match unsafe { slice(input.grab_targets, grab_count) } {
-        Ok(given) => {
-            for (t, c) in targets.iter_mut().zip(given) {
-                match convert::vec3(*c) {
-                    Ok(v) => *t = v,
-                    Err(e) => return e,
-                }
-            }
-        }
-        Err(e) => return e,
-    }
-    // SAFETY: the caller's promise for the accelerations; the count is bounded (checked), and
-    // they do not overlap the world (checked), which is borrowed while they are read.
-    let accelerations = match unsafe { slice(input.accelerations, acceleration_count) } {
-        Ok(a) => a,
-        Err(e) => return e,
-    };
-    if accelerations.iter().any(|a| convert::vec3(*a).is_err()) {
-        return hairsim_error::NotFinite;
-    }
     let step = |w: &mut SimWorld| {
-        if grab_count > w.grabs().len() {
-            return Err(hairsim_error::OutOfRange);
+        if checked.target_count > w.grabs().len() {
+            let more = Refused::from(hairsim_error::OutOfRange).field(Name::GrabTargetCount);
+            return Err(more.argument(Name::Input));
         }
-        for (g, &t) in targets.iter().take(grab_count).enumerate() {
+        for (g, &t) in checked.targets[..checked.target_count].iter().enumerate() {
             w.set_grab_target(g, t);
         }
-        Ok(if accelerations.is_empty() {
-            w.step(&StepInput {
-                head,
-                accelerations: None,
-            })
-        } else {
-            step_with_accelerations(w, head, accelerations)
-        })
+        let accelerations = checked.accelerations;
+        Ok(w.step(&StepInput {
+            head: checked.head,
+            accelerations: (!accelerations.is_empty()).then_some(accelerations),
+        }))
     };
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, step) } {
-        // SAFETY: the caller's promise for `report` (the world is no longer borrowed).
-        Ok(r) => code(unsafe { write_optional(report, convert::report_to_c(&r)) }),
-        Err(e) => e,
+    match unsafe { with_world(world, F, step) } {
+        // SAFETY: the caller's promise for `report` (checked; the world is no
+        // longer borrowed).
+        Ok(r) => code(unsafe { write_optional(report, convert::report_to_c(&r), Name::Report) }),
+        Err(e) => e.code,
     }
 }
 
@@ -720,45 +820,52 @@ pub unsafe extern "C" fn hairsim_strand_positions(
     capacity: usize,
     count: *mut usize,
 ) -> hairsim_error {
-    let checks = if capacity == 0 {
-        check_optional(out)
-    } else {
-        check_ptr(out)
-    };
+    const F: Function = Function::StrandPositions;
     // Only the first `NODES` entries are ever written.
     let used = capacity.min(NODES);
-    let checks = checks
-        .and(check_optional(count))
-        .and(check_disjoint(count, 1, world))
-        .and(check_disjoint(out, used, world));
-    if let Err(e) = checks {
-        return e;
+    let out_ok = if capacity == 0 {
+        check_optional(out, Name::Out)
+    } else {
+        check_ptr(out, Name::Out)
+    };
+    let checked = out_ok
+        .and(check_optional(count, Name::Count))
+        .and(check_disjoint(count, 1, world, Name::Count))
+        .and(check_disjoint(out, used, world, Name::Out));
+    if let Err(why) = checked {
+        // SAFETY: the caller's promise for `world`.
+        return unsafe { refuse(world, F, why) };
     }
+    // The node count goes to `count` also when `out` is too short.
+    let mut nodes = None;
     let copy = |w: &mut SimWorld| {
         let s = w
             .strands()
             .get(strand as usize)
-            .ok_or(hairsim_error::OutOfRange)?;
+            .ok_or(refused(hairsim_error::OutOfRange, Name::Strand))?;
+        nodes = Some(s.nodes());
+        if capacity < s.nodes() {
+            return Err(refused(hairsim_error::BufferTooSmall, Name::Capacity));
+        }
         let mut positions = [hairsim_vec3::default(); NODES];
         for (c, p) in positions.iter_mut().zip(s.positions()) {
             *c = convert::vec3_to_c(*p);
         }
-        Ok((positions, s.nodes()))
+        Ok(positions)
     };
     // SAFETY: the caller's promise for `world`.
-    let (positions, nodes) = match unsafe { with_world(world, copy) } {
+    let outcome = unsafe { with_world(world, F, copy) };
+    if let Some(n) = nodes {
+        // SAFETY: the caller's promise for `count` (checked; the world is no longer borrowed).
+        if let Err(e) = unsafe { write_optional(count, n, Name::Count) } {
+            return e.code;
+        }
+    }
+    let positions = match outcome {
         Ok(p) => p,
-        Err(e) => return e,
+        Err(e) => return e.code,
     };
-    // SAFETY: the caller's promise for `count` (checked aligned; the world is no longer
-    // borrowed).
-    if let Err(e) = unsafe { write_optional(count, nodes) } {
-        return e;
-    }
-    if capacity < nodes {
-        return hairsim_error::BufferTooSmall;
-    }
-    for (i, p) in positions.iter().take(nodes).enumerate() {
+    for (i, p) in positions.iter().take(nodes.unwrap_or(0)).enumerate() {
         // SAFETY: `i < nodes <= capacity`, and `out` is valid for `capacity` writes (the
         // caller's promise), non-NULL (capacity > 0 here) and aligned (checked).
         unsafe { ptr::write(out.add(i), *p) };
@@ -776,14 +883,17 @@ pub unsafe extern "C" fn hairsim_state_hash(
     world: *mut hairsim_world,
     out: *mut u64,
 ) -> hairsim_error {
-    if let Err(e) = check_ptr(out).and(check_disjoint(out, 1, world)) {
-        return e;
+    const F: Function = Function::StateHash;
+    if let Err(why) = check_ptr(out, Name::Out).and(check_disjoint(out, 1, world, Name::Out)) {
+        // SAFETY: the caller's promise for `world`.
+        return unsafe { refuse(world, F, why) };
     }
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, |w| Ok(w.state_hash())) } {
-        // SAFETY: the caller's promise for `out` (the world is no longer borrowed).
-        Ok(h) => code(unsafe { write(out, h) }),
-        Err(e) => e,
+    match unsafe { with_world(world, F, |w| Ok(w.state_hash())) } {
+        // SAFETY: the caller's promise for `out` (checked; the world is no
+        // longer borrowed).
+        Ok(h) => code(unsafe { write(out, h, Name::Out) }),
+        Err(e) => e.code,
     }
 }
 
@@ -797,8 +907,10 @@ pub unsafe extern "C" fn hairsim_get_info(
     world: *mut hairsim_world,
     out: *mut hairsim_world_info,
 ) -> hairsim_error {
-    if let Err(e) = check_ptr(out).and(check_disjoint(out, 1, world)) {
-        return e;
+    const F: Function = Function::GetInfo;
+    if let Err(why) = check_ptr(out, Name::Out).and(check_disjoint(out, 1, world, Name::Out)) {
+        // SAFETY: the caller's promise for `world`.
+        return unsafe { refuse(world, F, why) };
     }
     let info = |w: &mut SimWorld| {
         let mut info = hairsim_world_info {
@@ -814,10 +926,40 @@ pub unsafe extern "C" fn hairsim_get_info(
         Ok(info)
     };
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, info) } {
-        // SAFETY: the caller's promise for `out` (the world is no longer borrowed).
-        Ok(i) => code(unsafe { write(out, i) }),
-        Err(e) => e,
+    match unsafe { with_world(world, F, info) } {
+        // SAFETY: the caller's promise for `out` (checked; the world is no
+        // longer borrowed).
+        Ok(i) => code(unsafe { write(out, i, Name::Out) }),
+        Err(e) => e.code,
+    }
+}
+
+/// What the last call on `world` that reached it did: its code (`HAIRSIM_ERROR_OK` when it
+/// succeeded) and, when it was refused, the function, the argument and field it refused and
+/// the element concerned. Every call on a world but this one records its outcome there,
+/// except a call refused because of the world argument itself (NULL, misaligned, not
+/// initialised, busy): that refusal cannot be kept in the world. Reading it changes nothing.
+///
+/// # Safety
+/// `world` as for `hairsim_init`; `out`, if not NULL, valid for writes of a
+/// `hairsim_refusal`.
+#[no_mangle]
+pub unsafe extern "C" fn hairsim_last_refusal(
+    world: *mut hairsim_world,
+    out: *mut hairsim_refusal,
+) -> hairsim_error {
+    if let Err(why) = check_ptr(out, Name::Out).and(check_disjoint(out, 1, world, Name::Out)) {
+        return why.code;
+    }
+    // SAFETY: the caller's promise for `world`.
+    match unsafe { lease(world) } {
+        Ok(lease) => {
+            let record = *lease.record;
+            drop(lease);
+            // SAFETY: the caller's promise for `out` (checked; the world is no longer borrowed).
+            code(unsafe { write(out, record.to_c(), Name::Out) })
+        }
+        Err(e) => e.code,
     }
 }
 
@@ -833,15 +975,15 @@ pub unsafe extern "C" fn hairsim_shake_pose(
     t: f32,
     out: *mut hairsim_pose,
 ) -> hairsim_error {
-    if let Err(e) = check_ptr(out) {
-        return e;
+    if let Err(e) = check_ptr(out, Name::Out) {
+        return e.code;
     }
     // SAFETY: the caller's promise for `shake`.
-    let pose = unsafe { read(shake) }.and_then(|s| convert::shake_pose(&s, t));
+    let pose = unsafe { read(shake, Name::None) }.and_then(|s| convert::shake_pose(&s, t));
     match pose {
         // SAFETY: the caller's promise for `out`.
-        Ok(p) => code(unsafe { write(out, p) }),
-        Err(e) => e,
+        Ok(p) => code(unsafe { write(out, p, Name::Out) }),
+        Err(e) => e.code,
     }
 }
 
@@ -857,15 +999,15 @@ pub unsafe extern "C" fn hairsim_circle_target(
     t: f32,
     out: *mut hairsim_vec3,
 ) -> hairsim_error {
-    if let Err(e) = check_ptr(out) {
-        return e;
+    if let Err(e) = check_ptr(out, Name::Out) {
+        return e.code;
     }
     // SAFETY: the caller's promise for `circle`.
-    let target = unsafe { read(circle) }.and_then(|c| convert::circle_target(&c, t));
+    let target = unsafe { read(circle, Name::None) }.and_then(|c| convert::circle_target(&c, t));
     match target {
         // SAFETY: the caller's promise for `out`.
-        Ok(p) => code(unsafe { write(out, p) }),
-        Err(e) => e,
+        Ok(p) => code(unsafe { write(out, p, Name::Out) }),
+        Err(e) => e.code,
     }
 }
 
@@ -885,7 +1027,7 @@ pub unsafe extern "C" fn hairsim_get_capacity(out: *mut hairsim_capacity) -> hai
         world_align: WORLD_ALIGN,
     };
     // SAFETY: the caller's promise for `out`.
-    code(unsafe { write(out, capacity) })
+    code(unsafe { write(out, capacity, Name::Out) })
 }
 
 /// What `code` means, in words: a static NUL-terminated string, never NULL (an unknown code
@@ -894,19 +1036,19 @@ pub unsafe extern "C" fn hairsim_get_capacity(out: *mut hairsim_capacity) -> hai
 pub extern "C" fn hairsim_error_message(code: i32) -> *const c_char {
     let message: &'static core::ffi::CStr = match code {
         0 => c"success",
-        1 => c"a required pointer is NULL",
-        2 => c"a pointer is not aligned for its type (the world: HAIRSIM_WORLD_ALIGN)",
-        3 => c"a buffer is too small (the world: HAIRSIM_WORLD_SIZE bytes)",
+        1 => c"a required pointer is NULL (hairsim_last_refusal names which)",
+        2 => c"a pointer is not aligned for its type (hairsim_last_refusal names which)",
+        3 => c"a buffer is shorter than it needs (the world's: HAIRSIM_WORLD_SIZE bytes)",
         4 => c"the world buffer was not initialised by hairsim_init",
         5 => c"another call on this world is running (re-entry)",
         6 => c"a value is NaN or infinite, or a result would be",
-        7 => c"a value is out of its range (a parameter, an enum value, a flag bit, an index)",
+        7 => c"a value is out of its range (hairsim_last_refusal names the field)",
         8 => c"an effect is on that the solver cannot simulate",
         9 => c"a strand needs at least 3 nodes",
         10 => c"a strand has more nodes than HAIRSIM_NODES",
-        11 => c"a polyline segment is shorter than 1e-6 m",
+        11 => c"a polyline segment is shorter than 1e-6 m (hairsim_last_refusal names it)",
         12 => c"the polyline folds back on itself (a turning angle of 180 degrees)",
-        13 => c"a material value is out of range",
+        13 => c"a material value is out of its range (hairsim_last_refusal names the field)",
         14 => c"the world holds HAIRSIM_STRANDS strands already",
         15 => c"the world holds HAIRSIM_MAX_COLLIDERS colliders already",
         16 => c"the world holds HAIRSIM_MAX_GRABS grabs already",
@@ -917,6 +1059,7 @@ pub extern "C" fn hairsim_error_message(code: i32) -> *const c_char {
         21 => c"hairsim.h was generated for another HAIRSIM_STRANDS than the library",
         22 => c"hairsim.h was generated for another HAIRSIM_NODES than the library",
         23 => c"a collider needs HAIRSIM_EFFECT_COLLISIONS on, a grab HAIRSIM_EFFECT_GRABS",
+        24 => c"a polyline segment is longer than 1 m (hairsim_last_refusal names it)",
         _ => c"unknown error code",
     };
     message.as_ptr()

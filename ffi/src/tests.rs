@@ -346,6 +346,213 @@ fn presets_are_hair_and_effects_that_are_off_refuse_what_needs_them() {
     }
 }
 
+/// The last refusal of `world`: code, function, argument, field and index.
+fn last(world: *mut hairsim_world) -> (i32, std::string::String, u32) {
+    let mut r = core::mem::MaybeUninit::<hairsim_refusal>::uninit();
+    assert_eq!(
+        unsafe { hairsim_last_refusal(world, r.as_mut_ptr()) },
+        E::Ok
+    );
+    let r = unsafe { r.assume_init() };
+    let text = |p| unsafe { core::ffi::CStr::from_ptr(p) }.to_str().unwrap();
+    let mut what = std::string::String::from(text(r.function));
+    for (separator, part) in [(" ", text(r.argument)), (".", text(r.field))] {
+        if !part.is_empty() {
+            what = what + separator + part;
+        }
+    }
+    (r.code, what, r.index)
+}
+
+#[test]
+fn refusals_name_the_argument_the_field_and_the_element() {
+    let scene = Scene::firmware();
+    let mut storage = Storage::new();
+    let world = storage.init();
+    let expect = |code: E, what: &str, index: u32| {
+        let (c, w, i) = last(world);
+        assert_eq!((c, w.as_str(), i), (code as i32, what, index));
+    };
+    let none = u32::MAX;
+    expect(E::Ok, "", none);
+    unsafe {
+        let mut p = scene.params;
+        p.dt = f32::NAN;
+        assert_eq!(hairsim_configure(world, &p), E::NotFinite);
+        expect(E::NotFinite, "hairsim_configure params.dt", none);
+        p = scene.params;
+        p.rod_projection_iterations = 0;
+        assert_eq!(hairsim_configure(world, &p), E::OutOfRange);
+        expect(
+            E::OutOfRange,
+            "hairsim_configure params.rod_projection_iterations",
+            none,
+        );
+        p = scene.params;
+        p.solver = hairsim_solver::Dftl as u32;
+        assert_eq!(hairsim_configure(world, &p), E::UnsupportedEffect);
+        // Bending is the first effect DFTL cannot simulate: bit 2.
+        expect(E::UnsupportedEffect, "hairsim_configure params.effects", 2);
+        assert_eq!(hairsim_configure(world, ptr::null()), E::NullPointer);
+        expect(E::NullPointer, "hairsim_configure params", none);
+        assert_eq!(hairsim_configure(world, &scene.params), E::Ok);
+        expect(E::Ok, "hairsim_configure", none);
+
+        let m = &scene.material;
+        let add = |points: &[hairsim_vec3], m: &hairsim_material| {
+            hairsim_add_strand(world, points.as_ptr(), points.len(), m, ptr::null_mut())
+        };
+        let mut bad = scene.strands[0].clone();
+        bad[3].z = f32::NAN;
+        assert_eq!(add(&bad, m), E::NotFinite);
+        expect(E::NotFinite, "hairsim_add_strand points", 3);
+        bad = scene.strands[0].clone();
+        bad[5] = bad[4];
+        assert_eq!(add(&bad, m), E::DegenerateSegment);
+        expect(E::DegenerateSegment, "hairsim_add_strand points", 4);
+        bad[5].x += 2.0;
+        assert_eq!(add(&bad, m), E::LongSegment);
+        expect(E::LongSegment, "hairsim_add_strand points", 4);
+        assert_eq!(add(&bad[..2], m), E::TooFewNodes);
+        expect(E::TooFewNodes, "hairsim_add_strand count", none);
+        let mut soft = *m;
+        soft.youngs_modulus = 0.0;
+        assert_eq!(add(&scene.strands[0], &soft), E::InvalidMaterial);
+        expect(
+            E::InvalidMaterial,
+            "hairsim_add_strand material.youngs_modulus",
+            none,
+        );
+        soft = *m;
+        soft.density = f32::INFINITY;
+        assert_eq!(add(&scene.strands[0], &soft), E::NotFinite);
+        expect(E::NotFinite, "hairsim_add_strand material.density", none);
+        assert_eq!(add(&scene.strands[0], m), E::Ok);
+
+        let mut c = scene.colliders[0];
+        c.radius = 0.0;
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::InvalidCollider
+        );
+        expect(
+            E::InvalidCollider,
+            "hairsim_add_collider collider.radius",
+            none,
+        );
+        c = hairsim_collider {
+            shape: hairsim_shape::Plane as u32,
+            b: hairsim_vec3 {
+                x: 0.0,
+                y: 2.0,
+                z: 0.0,
+            },
+            ..c
+        };
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::InvalidCollider
+        );
+        expect(E::InvalidCollider, "hairsim_add_collider collider.b", none);
+        c.attached_to_head = 7;
+        assert_eq!(
+            hairsim_add_collider(world, &c, ptr::null_mut()),
+            E::OutOfRange
+        );
+        expect(
+            E::OutOfRange,
+            "hairsim_add_collider collider.attached_to_head",
+            none,
+        );
+
+        let mut g = scene.grabs[0];
+        g.strand = 3;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        expect(E::InvalidGrab, "hairsim_add_grab grab.strand", none);
+        g = scene.grabs[0];
+        g.node = 1;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        expect(E::InvalidGrab, "hairsim_add_grab grab.node", none);
+        g.node = scene.grabs[0].node;
+        g.force_limit = -1.0;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        expect(E::InvalidGrab, "hairsim_add_grab grab.force_limit", none);
+        g.force_limit = f32::NAN;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::NotFinite);
+        expect(E::NotFinite, "hairsim_add_grab grab.force_limit", none);
+        // A coupling out of its ranges, or not finite.
+        g.force_limit = scene.grabs[0].force_limit;
+        (g.stiffness, g.damping) = (1.0e6, 0.01);
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        expect(E::InvalidGrab, "hairsim_add_grab grab.stiffness", none);
+        (g.stiffness, g.damping) = (20.0, -1.0);
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::InvalidGrab);
+        expect(E::InvalidGrab, "hairsim_add_grab grab.damping", none);
+        g.damping = f32::INFINITY;
+        assert_eq!(hairsim_add_grab(world, &g, ptr::null_mut()), E::NotFinite);
+        expect(E::NotFinite, "hairsim_add_grab grab.damping", none);
+        assert_eq!(
+            hairsim_add_grab(world, &scene.grabs[0], ptr::null_mut()),
+            E::Ok
+        );
+
+        let mut i = input(identity());
+        let targets = [
+            scene.grabs[0].target,
+            hairsim_vec3 {
+                y: f32::NAN,
+                ..Default::default()
+            },
+        ];
+        i.grab_targets = targets.as_ptr();
+        i.grab_target_count = 2;
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::NotFinite);
+        expect(E::NotFinite, "hairsim_step input.grab_targets", 1);
+        i.grab_target_count = 1;
+        let accelerations = [
+            hairsim_vec3::default(),
+            hairsim_vec3 {
+                x: f32::INFINITY,
+                ..Default::default()
+            },
+        ];
+        i.accelerations = accelerations.as_ptr();
+        i.acceleration_count = 2;
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::NotFinite);
+        expect(E::NotFinite, "hairsim_step input.accelerations", 1);
+        i.acceleration_count = 1;
+        let mut head = identity();
+        head.rotation.w = 3.0;
+        i.head = head;
+        assert_eq!(hairsim_step(world, &i, ptr::null_mut()), E::OutOfRange);
+        expect(E::OutOfRange, "hairsim_step input.head", none);
+        let mut scratch = vec![0u64; 64];
+        let odd = scratch
+            .as_mut_ptr()
+            .cast::<u8>()
+            .add(1)
+            .cast::<hairsim_step_report>();
+        assert_eq!(hairsim_step(world, &input(identity()), odd), E::Misaligned);
+        expect(E::Misaligned, "hairsim_step report", none);
+        let mut out = [hairsim_vec3::default(); 2];
+        let code = hairsim_strand_positions(world, 0, out.as_mut_ptr(), 2, ptr::null_mut());
+        assert_eq!(code, E::BufferTooSmall);
+        expect(E::BufferTooSmall, "hairsim_strand_positions capacity", none);
+        assert_eq!(
+            hairsim_step(world, &input(identity()), ptr::null_mut()),
+            E::Ok
+        );
+        expect(E::Ok, "hairsim_step", none);
+        // A refusal of the world itself is not kept: the last call's outcome stays.
+        assert_eq!(
+            hairsim_configure(world.cast::<u8>().add(1).cast(), &scene.params),
+            E::Misaligned
+        );
+        expect(E::Ok, "hairsim_step", none);
+        assert_eq!(hairsim_last_refusal(world, ptr::null_mut()), E::NullPointer);
+    }
+}
+
 #[test]
 fn the_firmware_scene_through_the_c_functions_gives_the_core_hash() {
     let scene = Scene::firmware();
@@ -721,7 +928,7 @@ fn refused_arguments_have_their_codes() {
             let message = core::ffi::CStr::from_ptr(hairsim_error_message(code));
             assert!(!message.is_empty());
             let unknown = message.to_str().unwrap() == "unknown error code";
-            assert_eq!(unknown, !(0..=23).contains(&code), "{code}");
+            assert_eq!(unknown, !(0..=24).contains(&code), "{code}");
         }
     }
 }
@@ -779,8 +986,13 @@ fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
         let count = c_points.len();
         let code = hairsim_add_strand(world, c_points.as_ptr(), count, &material, ptr::null_mut());
         assert_eq!(code, E::Ok);
-        // 1e6 N/m is past the coupling's range.
+        // 1e6 N/m is past the coupling's range, and the refusal names the field.
         assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::InvalidGrab);
+        let (code, what, _) = last(world);
+        assert_eq!(
+            (code, what.as_str()),
+            (E::InvalidGrab as i32, "hairsim_add_grab grab.stiffness")
+        );
         grab.stiffness = coupling.stiffness;
         assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::Ok);
     }

@@ -12,7 +12,7 @@
 /// when the ABI breaks and the minor version when it only grows.
 pub const HAIRSIM_VERSION_MAJOR: u32 = 0;
 /// The library's minor version (see `HAIRSIM_VERSION_MAJOR`).
-pub const HAIRSIM_VERSION_MINOR: u32 = 4;
+pub const HAIRSIM_VERSION_MINOR: u32 = 5;
 /// The library's patch version: changes that no header sees (fixes, speed).
 pub const HAIRSIM_VERSION_PATCH: u32 = 0;
 /// The three parts in one word, `0x00MMmmpp`, as `hairsim_version()` returns it; the header's
@@ -127,7 +127,8 @@ pub enum hairsim_error {
     TooFewNodes = 9,
     /// A polyline has more points than `HAIRSIM_NODES`.
     TooManyNodes = 10,
-    /// A polyline segment is shorter than 1 micrometre.
+    /// A polyline segment is shorter than 1 micrometre (`hairsim_last_refusal` gives its
+    /// index).
     DegenerateSegment = 11,
     /// A polyline folds back on itself (a turning angle of 180 degrees).
     FoldedSegment = 12,
@@ -156,6 +157,8 @@ pub enum hairsim_error {
     /// A collider was added while `HAIRSIM_EFFECT_COLLISIONS` is off, or a grab while
     /// `HAIRSIM_EFFECT_GRABS` is off: it would do nothing. Turn the effect on first.
     EffectOff = 23,
+    /// A polyline segment is longer than 1 m.
+    LongSegment = 24,
 }
 
 /// The model (`hairsim_params::solver`).
@@ -284,19 +287,21 @@ pub struct hairsim_circle {
     pub frequency: f32,
 }
 
-/// A round hair fibre's material (SI units).
+/// A round hair fibre's material (SI units). Each field has a range (outside it:
+/// `HAIRSIM_ERROR_INVALID_MATERIAL`, the field named by `hairsim_last_refusal`); both solvers'
+/// presets hold at every corner of the ranges (docs/embedding.md).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct hairsim_material {
-    /// Young's modulus E, Pa.
+    /// Young's modulus E, Pa: 1e7 to 1e13 (human hair 3.5e9).
     pub youngs_modulus: f32,
-    /// Shear modulus G, Pa.
+    /// Shear modulus G, Pa: 1e7 to 1e13 (human hair 1.3e9).
     pub shear_modulus: f32,
-    /// Fibre radius, m (0 < r <= 0.01).
+    /// Fibre radius, m: 1e-5 to 5e-4 (human hair 4e-5).
     pub radius: f32,
-    /// Density, kg/m^3.
+    /// Density, kg/m^3: 500 to 3000 (human hair 1300).
     pub density: f32,
-    /// Multiplier on bending about the minor axis, 1 to 100.
+    /// Multiplier on bending about the minor axis (an elliptic section), 1 to 10.
     pub minor_axis_penalty: f32,
 }
 
@@ -461,6 +466,26 @@ pub struct hairsim_world_info {
     pub grabs: u32,
     /// A `hairsim_grab_status` per grab slot.
     pub grab_status: [u32; HAIRSIM_MAX_GRABS],
+}
+
+/// What the last call on a world that reached it refused, or that it succeeded
+/// (`hairsim_last_refusal`). The strings are static and never NULL ("" for none).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct hairsim_refusal {
+    /// The `hairsim_error` the call returned (`HAIRSIM_ERROR_OK` when it succeeded).
+    pub code: i32,
+    /// The function, e.g. "hairsim_add_strand" ("" before any call).
+    pub function: *const core::ffi::c_char,
+    /// The argument refused, as the header names it, e.g. "material" ("" for none).
+    pub argument: *const core::ffi::c_char,
+    /// The field of that argument, as the header names it, e.g. "radius" ("" for the whole
+    /// argument).
+    pub field: *const core::ffi::c_char,
+    /// The node, segment, strand or array element concerned, or `UINT32_MAX` for none: the
+    /// node of a non-finite point, the segment too short or too long, the node a polyline
+    /// folds at, the grab target or acceleration that is not finite.
+    pub index: u32,
 }
 
 /// The library's build-time capacities and world layout, to check against the header.

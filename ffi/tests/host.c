@@ -38,6 +38,7 @@ static const char *name_of(hairsim_error code) {
         "DEGENERATE_SEGMENT", "FOLDED_SEGMENT", "INVALID_MATERIAL", "STRANDS_FULL",
         "COLLIDERS_FULL", "GRABS_FULL", "INVALID_COLLIDER", "INVALID_GRAB", "OVERLAP",
         "VERSION_MISMATCH", "STRANDS_MISMATCH", "NODES_MISMATCH", "EFFECT_OFF",
+        "LONG_SEGMENT",
     };
     return code >= 0 && (size_t)code < sizeof names / sizeof names[0] ? names[code] : "?";
 }
@@ -54,6 +55,25 @@ static void expect(hairsim_error expected, hairsim_error got, const char *call, 
         printf("FAIL line %d: %s returned %s (%s), expected %s\n", line, call, name_of(got),
                hairsim_error_message(got), name_of(expected));
     }
+}
+
+/* Checks that the world's last refusal names `function`, `argument`, `field` and `index`. */
+static void check(int ok, const char *what);
+
+static void refusal(hairsim_world *world, const char *function, const char *argument,
+                    const char *field, uint32_t index) {
+    hairsim_refusal r;
+    int ok = hairsim_last_refusal(world, &r) == HAIRSIM_ERROR_OK &&
+             strcmp(r.function, function) == 0 && strcmp(r.argument, argument) == 0 &&
+             strcmp(r.field, field) == 0 && r.index == index;
+    if (!ok) {
+        printf("     refusal: %s %s.%s [%u]\n", r.function, r.argument, r.field,
+               (unsigned)r.index);
+    }
+    char what[160];
+    snprintf(what, sizeof what, "the refusal names %s %s.%s [%u]", function, argument, field,
+             (unsigned)index);
+    check(ok, what);
 }
 
 static void check(int ok, const char *what) {
@@ -162,6 +182,7 @@ static void refusals(void) {
            hairsim_configure(world, (const hairsim_params *)(const void *)(bytes + 64)));
     p.dt = 0.0f / 0.0f;
     EXPECT(HAIRSIM_ERROR_NOT_FINITE, hairsim_configure(world, &p));
+    refusal(world, "hairsim_configure", "params", "dt", UINT32_MAX);
     p.dt = 1.0f;
     EXPECT(HAIRSIM_ERROR_OUT_OF_RANGE, hairsim_configure(world, &p));
     p = params;
@@ -220,12 +241,18 @@ static void refusals(void) {
     memcpy(bad, line, sizeof bad);
     bad[3] = bad[2];
     EXPECT(HAIRSIM_ERROR_DEGENERATE_SEGMENT, hairsim_add_strand(world, bad, 5, &hair, &index));
+    refusal(world, "hairsim_add_strand", "points", "", 2);
+    bad[3].x = 1.0e30f;
+    EXPECT(HAIRSIM_ERROR_LONG_SEGMENT, hairsim_add_strand(world, bad, 5, &hair, &index));
+    refusal(world, "hairsim_add_strand", "points", "", 2);
     memcpy(bad, line, sizeof bad);
     bad[3] = bad[1];
     EXPECT(HAIRSIM_ERROR_FOLDED_SEGMENT, hairsim_add_strand(world, bad, 5, &hair, &index));
+    refusal(world, "hairsim_add_strand", "points", "", 2);
     hairsim_material soft = hair;
     soft.radius = 1.0f;
     EXPECT(HAIRSIM_ERROR_INVALID_MATERIAL, hairsim_add_strand(world, line, 5, &soft, &index));
+    refusal(world, "hairsim_add_strand", "material", "radius", UINT32_MAX);
     soft.density = 0.0f / 0.0f;
     EXPECT(HAIRSIM_ERROR_NOT_FINITE, hairsim_add_strand(world, line, 5, &soft, &index));
     EXPECT(HAIRSIM_ERROR_MISALIGNED,
@@ -277,6 +304,15 @@ static void refusals(void) {
     EXPECT(HAIRSIM_ERROR_INVALID_GRAB, hairsim_add_grab(world, &g, NULL));
     g.force_limit = 0.0f / 0.0f;
     EXPECT(HAIRSIM_ERROR_NOT_FINITE, hairsim_add_grab(world, &g, NULL));
+    /* A coupling outside its ranges names its field. */
+    g = grab;
+    g.stiffness = 1e6f;
+    EXPECT(HAIRSIM_ERROR_INVALID_GRAB, hairsim_add_grab(world, &g, NULL));
+    refusal(world, "hairsim_add_grab", "grab", "stiffness", UINT32_MAX);
+    g.stiffness = 20.0f;
+    g.damping = -1.0f;
+    EXPECT(HAIRSIM_ERROR_INVALID_GRAB, hairsim_add_grab(world, &g, NULL));
+    refusal(world, "hairsim_add_grab", "grab", "damping", UINT32_MAX);
     for (int i = 0; i < HAIRSIM_MAX_GRABS; i++) {
         EXPECT(HAIRSIM_ERROR_OK, hairsim_add_grab(world, &grab, &index));
     }

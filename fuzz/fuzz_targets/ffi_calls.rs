@@ -125,6 +125,7 @@ enum Call {
     CircleTarget(Option<[F; 5]>, F, Out),
     Capacity(Out),
     Message(i32),
+    LastRefusal(WorldArg, Out),
 }
 
 /// Two zeroed world buffers, as C `static`s are.
@@ -261,7 +262,7 @@ fn vec3(v: [F; 3]) -> hairsim_vec3 {
 
 fn check_code(code: hairsim_error) {
     let c = code as i32;
-    assert!((0..=23).contains(&c), "unknown code {c}");
+    assert!((0..=24).contains(&c), "unknown code {c}");
     let message = unsafe { CStr::from_ptr(hairsim_error_message(c)) };
     assert!(!message.is_empty());
 }
@@ -296,6 +297,15 @@ fuzz_target!(|calls: Vec<Call>| {
             }
             if code != hairsim_error::Ok {
                 assert_eq!(worlds.snapshot(WorldArg::World(w)), before, "{call:?}");
+            }
+            // Every call that reached an initialised world keeps its outcome there.
+            if initialised && !matches!(call, Call::Init(..)) {
+                let world = worlds.ptr(WorldArg::World(w));
+                let mut refusal = MaybeUninit::<hairsim_refusal>::uninit();
+                let read = unsafe { hairsim_last_refusal(world, refusal.as_mut_ptr()) };
+                assert_eq!(read, hairsim_error::Ok, "{call:?}");
+                let refusal = unsafe { refusal.assume_init() };
+                assert_eq!(refusal.code, code as i32, "{call:?}");
             }
         }
     }
@@ -566,6 +576,20 @@ unsafe fn call_one(call: &Call, worlds: &mut Worlds, out: &mut OutBuf) -> hairsi
             let message = CStr::from_ptr(hairsim_error_message(*code));
             assert!(!message.is_empty());
             hairsim_error::Ok
+        }
+        Call::LastRefusal(w, o) => {
+            let world = worlds.ptr(*w);
+            let out = out.ptr::<hairsim_refusal>(*o, worlds, Some(*w));
+            let code = hairsim_last_refusal(world, out);
+            if code == hairsim_error::Ok {
+                let r = &*out;
+                assert!((0..=24).contains(&r.code), "unknown code {}", r.code);
+                for text in [r.function, r.argument, r.field] {
+                    assert!(!text.is_null());
+                    let _ = CStr::from_ptr(text);
+                }
+            }
+            code
         }
     }
 }

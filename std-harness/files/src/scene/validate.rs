@@ -2,6 +2,7 @@
 //! fields go together. Each failure names its field and says what is allowed.
 
 use hairsim_core::params::{MAX_DT, MIN_DT};
+use hairsim_core::strand::MATERIAL_RANGES;
 use hairsim_core::{Coupling, Effect, Solver};
 
 use super::error::FieldError;
@@ -285,20 +286,24 @@ fn name(name: &str) -> Check {
 /// Checks a material (or a strand's override).
 pub fn material(prefix: &str, m: &MaterialSpec) -> Check {
     let f = |name: &str| format!("{prefix}.{name}");
-    if let Some(v) = m.youngs_modulus {
-        range(&f("youngs_modulus"), v, 0.0, 1.0e12, " Pa")?;
-    }
-    if let Some(v) = m.shear_modulus {
-        range(&f("shear_modulus"), v, 0.0, 1.0e12, " Pa")?;
-    }
-    if let Some(v) = m.radius {
-        positive(&f("radius"), v, 0.01, " m")?;
-    }
-    if let Some(v) = m.density {
-        positive(&f("density"), v, 1.0e5, " kg/m3")?;
-    }
-    if let Some(v) = m.minor_axis_penalty {
-        range(&f("minor_axis_penalty"), v, 1.0, 100.0, "")?;
+    // The core's ranges (`Material::validate`), in their order.
+    let given = [
+        m.youngs_modulus,
+        m.shear_modulus,
+        m.radius,
+        m.density,
+        m.minor_axis_penalty,
+    ];
+    for (v, r) in given.into_iter().zip(&MATERIAL_RANGES) {
+        match v {
+            Some(v) if !(v.is_finite() && (r.least..=r.most).contains(&v)) => {
+                return fail(
+                    f(r.field),
+                    format!("{v} is out of range, allowed {}", r.allowed),
+                );
+            }
+            _ => {}
+        }
     }
     if let Some(v) = m.tip_stiffness {
         range(
