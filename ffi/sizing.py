@@ -16,11 +16,15 @@ Microseconds at 168 MHz come from the instruction counts by firmware/latency.py'
 Cortex-M4F takes one cycle for most instructions, 14 for VDIV and VSQRT and 3 for the
 multiply-accumulates, weighted by their share of the step's code in the disassembly.
 
+It also runs firmware-c/corrupt.c (1,000 stray writes into a world) and writes its outcomes
+into docs/embedding.md (between its `corruption` markers).
+
 Usage:
   python3 ffi/sizing.py            measure, then write docs/embedding.md and ffi/sizing.txt
   python3 ffi/sizing.py --check    measure, then fail if a committed figure is off by more
                                    than the tolerance (see check())
   python3 ffi/sizing.py --sizes 4x16,16x32 ...   only these capacities (with --check: their rows)
+  python3 ffi/sizing.py --corruption LOG        check a corruption run's output (.ci/ffi's)
 """
 import argparse
 import concurrent.futures
@@ -42,6 +46,7 @@ TARGET = "thumbv7em-none-eabihf"
 DOC = ROOT / "docs/embedding.md"
 SUMMARY = ROOT / "ffi/sizing.txt"
 BEGIN, END = "<!-- sizing: begin -->", "<!-- sizing: end -->"
+CORRUPTION = ("<!-- corruption: begin -->", "<!-- corruption: end -->")
 QEMU = ["qemu-system-arm", "-cpu", "cortex-m4", "-machine", "mps2-an386", "-nographic",
         "-icount", "shift=0", "-semihosting-config", "enable=on,target=native", "-kernel"]
 MHZ = 168
@@ -133,6 +138,57 @@ def measure_all(sizes):
     # The library of the default capacity again, as the rest of the checks expect it.
     run(["cargo", "build", "-q", "--release", "--target", TARGET], cwd=ROOT / "ffi")
     return results
+
+
+def measure_corruption():
+    """Builds firmware-c/corrupt.c against the library with its panic-test feature and runs it
+    under QEMU; returns its output."""
+    run(["make", "-s", "-C", "firmware-c", "corrupt", "BUILD=build/corrupt",
+         "FEATURES=rod,dftl,panic-test"])
+    return run(["timeout", "900", *QEMU, str(ROOT / "firmware-c/build/corrupt/corrupt.elf")])
+
+
+def corruption_counts(text):
+    """The corruption run's outcomes, error codes and check refusals, from its output."""
+    m = re.search(r"^corruption trials (\d+) stepped (\d+) error (\d+) hook (\d+) "
+                  r"hardfault (\d+) hang (\d+)$", text, re.M)
+    if not m:
+        sys.exit(f"sizing: no corruption counts in:\n{text}")
+    counts = dict(zip(["trials", "stepped", "error", "hook", "hardfault", "hang"],
+                      map(int, m.groups())))
+    checked = re.search(r"^corruption stepped, then refused by hairsim_check: (\d+)$", text, re.M)
+    counts["check"] = int(checked.group(1)) if checked else 0
+    counts["hooked"] = bool(re.search(r"^corruption panic hook called", text, re.M))
+    return counts
+
+
+def corruption_markdown(c):
+    return (f"| outcome | trials |\n|---|---|\n"
+            f"| stepped three times (no call refused it) | {c['stepped']} |\n"
+            f"| – of which `hairsim_check` then refused as corrupt (state or rest data) | "
+            f"{c['check']} |\n"
+            f"| refused with an error (`HAIRSIM_ERROR_CORRUPT`) | {c['error']} |\n"
+            f"| the panic hook called | {c['hook']} |\n"
+            f"| hard fault | {c['hardfault']} |\n"
+            f"| hang | {c['hang']} |")
+
+
+def check_corruption(log):
+    """The corruption run's log against the committed table: no hard fault, no hang, the
+    hook called by the panic test, and every count within TOLERANCE of the trials."""
+    new = corruption_counts(Path(log).read_text())
+    failures = []
+    if new["hardfault"] or new["hang"] or not new["hooked"]:
+        failures.append(f"hard faults {new['hardfault']}, hangs {new['hang']}, "
+                        f"panic hook called: {new['hooked']}")
+    committed = DOC.read_text().split(CORRUPTION[0], 1)[-1].split(CORRUPTION[1], 1)[0]
+    old = numbers(committed)
+    fresh = numbers(corruption_markdown(new))
+    if len(old) != len(fresh) or any(abs(a - b) > TOLERANCE * new["trials"]
+                                      for a, b in zip(old, fresh)):
+        failures.append(f"docs/embedding.md's corruption table is stale: committed {old}, "
+                        f"measured {fresh}")
+    return failures
 
 
 def k(instructions):
@@ -251,7 +307,15 @@ def main():
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--check", action="store_true")
     parser.add_argument("--sizes", help="e.g. 4x16,16x32 (default: all)")
+    parser.add_argument("--corruption", metavar="LOG",
+                        help="only check the corruption run's LOG against docs/embedding.md")
     args = parser.parse_args()
+    if args.corruption:
+        failures = check_corruption(args.corruption)
+        if failures:
+            sys.exit("sizing: " + "\n  ".join(failures))
+        print("sizing: the corruption run holds: no hard fault, no hang, the hook called")
+        return
     sizes = SIZES
     if args.sizes:
         sizes = [tuple(int(x) for x in s.split("x")) for s in args.sizes.split(",")]
@@ -269,7 +333,11 @@ def main():
         sys.exit("sizing: writing the table needs every capacity (no --sizes)")
     before, rest = doc.split(BEGIN, 1)
     after = rest.split(END, 1)[1]
-    DOC.write_text(f"{before}{BEGIN}\n{markdown(results)}\n{END}{after}")
+    doc = f"{before}{BEGIN}\n{markdown(results)}\n{END}{after}"
+    counts = corruption_counts(measure_corruption())
+    before, rest = doc.split(CORRUPTION[0], 1)
+    after = rest.split(CORRUPTION[1], 1)[1]
+    DOC.write_text(f"{before}{CORRUPTION[0]}\n{corruption_markdown(counts)}\n{CORRUPTION[1]}{after}")
     SUMMARY.write_text(summary(results))
     run(["bash", "ffi/generate-header.sh"])
     print(markdown(results))

@@ -13,8 +13,11 @@ int main(void);
 
 void reset_handler(void);
 void fault_handler(void);
+void systick_handler(void);
 
-/* Initial stack pointer, reset, NMI, hard fault, memory management, bus and usage faults. */
+/* Initial stack pointer, reset, NMI, hard fault, memory management, bus and usage faults,
+   and SysTick (entry 15). A program may define its own fault and SysTick handlers (these are
+   weak): corrupt.c does. */
 __attribute__((section(".vectors"), used)) static const uintptr_t vectors[16] = {
     (uintptr_t)__stack_top,
     (uintptr_t)reset_handler,
@@ -23,6 +26,7 @@ __attribute__((section(".vectors"), used)) static const uintptr_t vectors[16] = 
     (uintptr_t)fault_handler,
     (uintptr_t)fault_handler,
     (uintptr_t)fault_handler,
+    [15] = (uintptr_t)systick_handler,
 };
 
 void reset_handler(void) {
@@ -39,7 +43,10 @@ void reset_handler(void) {
     semihosting_exit(main() == 0);
 }
 
-void fault_handler(void) {
+__attribute__((weak)) void fault_handler(void) {
     semihosting_write0("error: fault\n");
     semihosting_exit(0);
 }
+
+/* SysTick's interrupt is never enabled but by a program that defines its own handler. */
+__attribute__((weak)) void systick_handler(void) {}

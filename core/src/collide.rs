@@ -15,7 +15,10 @@ pub const MIN_RADIUS: Real = 1.0e-5;
 pub const MAX_RADIUS: Real = 1.0e4;
 
 /// A collider's geometry.
+///
+/// `repr(C, u8)`: the variant's index in the first byte (`crate::world::WorldLayout`).
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, u8)]
 pub enum Shape {
     /// A ball.
     Sphere {

@@ -132,8 +132,12 @@ impl Effects {
 }
 
 /// Which model steps the strands.
+///
+/// One byte, the variant's index (`repr(u8)`): a world's raw bytes can be checked before they
+/// are read as one (`crate::world::WorldLayout`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
 pub enum Solver {
     /// Discrete Kirchhoff rods with fast manifold projection (Kmoch et al. 2009).
     Rod,

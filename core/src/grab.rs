@@ -8,8 +8,12 @@ use crate::math::{Real, Vec3};
 pub use crate::capacities::MAX_GRABS;
 
 /// Whether a grab holds its node.
+///
+/// One byte, the variant's index (`repr(u8)`): a world's raw bytes can be checked before they
+/// are read as one (`crate::world::WorldLayout`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
 pub enum GrabStatus {
     /// The node follows the target.
     Held,

@@ -6,8 +6,12 @@ use crate::error::ParamError;
 use crate::math::{Real, Vec3};
 
 /// Which quasistatic twist a scene uses.
+///
+/// One byte, the variant's index (`repr(u8)`): a world's raw bytes can be checked before they
+/// are read as one (`crate::world::WorldLayout`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
 pub enum TwistMethod {
     /// Kmoch 2009 Sec. 6.2: material frames follow the curvature binormals.
     HairOptimised,
@@ -27,8 +31,12 @@ impl TwistMethod {
 }
 
 /// How iterative stages decide when to stop.
+///
+/// One byte, the variant's index (`repr(u8)`): a world's raw bytes can be checked before they
+/// are read as one (`crate::world::WorldLayout`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
 pub enum Mode {
     /// Stop early at the tolerance (desktops).
     Converge,

@@ -155,6 +155,66 @@ pub struct RestStrand<const N: usize> {
     pub rod: RodRest<N>,
 }
 
+impl<const N: usize> RestStrand<N> {
+    /// A checksum of every value of the rest data, word by word (FNV-1a 32 over the `f32`
+    /// bit patterns and the node count): what a caller keeps when the strand is built, to
+    /// find a stray write into rest data that no step would notice (the C ABI's
+    /// `hairsim_check`). Not the state hash: rest data never changes once built.
+    #[must_use]
+    pub fn checksum(&self) -> u32 {
+        let mut sum = Words(0x811c_9dc5);
+        sum.word(self.nodes as u32);
+        sum.vec3s(&self.position);
+        for values in [&self.segment_length, &self.mass, &self.inverse_mass] {
+            sum.reals(values);
+        }
+        let d = &self.dftl;
+        sum.vec3s(&[d.root_tangent, d.root_normal]);
+        sum.vec3s(&d.local_rest);
+        sum.reals(&d.root_distance);
+        sum.reals(&d.strain_scale);
+        let r = &self.rod;
+        for values in [
+            &r.rest_length,
+            &r.voronoi_length,
+            &r.inverse_voronoi_length,
+            &r.bending_stiffness,
+            &r.rest_theta,
+            &r.rest_twist,
+        ] {
+            sum.reals(values);
+        }
+        sum.reals(&[r.minor_axis_penalty, r.twist_stiffness, r.stable_time_step]);
+        for pair in &r.rest_twist_rotation {
+            sum.reals(pair);
+        }
+        for pairs in &r.rest_curvature {
+            sum.reals(&pairs[0]);
+            sum.reals(&pairs[1]);
+        }
+        sum.0
+    }
+}
+
+/// FNV-1a 32 taken a word at a time.
+struct Words(u32);
+
+impl Words {
+    fn word(&mut self, w: u32) {
+        self.0 = (self.0 ^ w).wrapping_mul(0x0100_0193);
+    }
+    fn reals(&mut self, values: &[Real]) {
+        for v in values {
+            self.word(v.to_bits());
+        }
+    }
+    fn vec3s(&mut self, values: &[Vec3]) {
+        for v in values {
+            self.reals(&[v.x, v.y, v.z]);
+        }
+    }
+}
+
 /// Rest data of the rod energies, computed once when a strand is built
 /// ([`RodRest::compute`]): with these, the strand's rest polyline — straight, wavy or helical —
 /// has zero elastic energy and zero elastic force under both twist methods.

@@ -27,6 +27,13 @@ pub struct StepInput<'a> {
     pub accelerations: Option<&'a [Vec3]>,
 }
 
+/// A world's strands: up to `S` of up to `N` nodes.
+pub type Strands<const S: usize, const N: usize> = heapless::Vec<Strand<N>, S>;
+/// A world's colliders.
+pub type Colliders = heapless::Vec<Collider, MAX_COLLIDERS>;
+/// A world's grabs.
+pub type Grabs = heapless::Vec<Grab, MAX_GRABS>;
+
 /// A fixed-capacity world: up to `S` strands of up to `N` nodes, stepped with the math
 /// backend `M`. Holds no heap memory; `World::new` is `const`, so a world can live in a
 /// `static`.
@@ -35,9 +42,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     params: Params,
     /// DFTL's coefficients at `params.dt`, computed once in `configure` (never per step).
     dftl: DftlCoefficients,
-    strands: heapless::Vec<Strand<N>, S>,
-    colliders: heapless::Vec<Collider, MAX_COLLIDERS>,
-    grabs: heapless::Vec<Grab, MAX_GRABS>,
+    strands: Strands<S, N>,
+    colliders: Colliders,
+    grabs: Grabs,
     head: Pose,
     steps: u64,
     /// A grab target given since the last step was not finite (and was ignored): the next
@@ -47,6 +54,51 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     /// snapshotted or cloned).
     scratch: RodScratch<M, N>,
     math: PhantomData<M>,
+}
+
+/// Where a world keeps the bytes that not every value fits, as offsets from the world's
+/// start: for a caller that checks a world's raw bytes before it reads them as a `World` (the
+/// C ABI's `hairsim_check`, after a reset in the middle of a call or a stray write). The
+/// enums are one byte, the variant's index (`repr(u8)`): [`Solver`](crate::Solver) and
+/// [`crate::params::Mode`] and [`crate::params::TwistMethod`] below 2; the world's flag of a
+/// bad grab target since the last step is a `bool`. The lists are
+/// `heapless::Vec`s ([`Strands`], [`Colliders`], [`Grabs`]): every byte pattern is one, but
+/// their lengths must be at most their capacities before their elements are read. Within
+/// an element, the public fields' offsets are `core::mem::offset_of!`'s: a strand's
+/// `rest.nodes` (3 to `N`) and `schedule.implicit_bending` (a `bool`), a collider's `shape` (its
+/// first byte, the variant, below 3: [`Shape`](crate::Shape) is `repr(C, u8)`) and
+/// `attached_to_head` (a `bool`), a grab's `status` (below 3), `strand`, `node` and `coupling`
+/// (an `Option<Coupling>`, whose tag Rust places without a promise: the C ABI's tests check
+/// where). Everything else in a world is floats and integers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WorldLayout {
+    /// `params.solver`.
+    pub solver: usize,
+    /// `params.mode`.
+    pub mode: usize,
+    /// `params.rod.twist`.
+    pub twist: usize,
+    /// The flag of a non-finite grab target given since the last step (a `bool`).
+    pub bad_target: usize,
+    /// The strands, a [`Strands`].
+    pub strands: usize,
+    /// The colliders, a [`Colliders`].
+    pub colliders: usize,
+    /// The grabs, a [`Grabs`].
+    pub grabs: usize,
+}
+
+impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
+    /// Where this world type keeps what [`WorldLayout`] lists.
+    pub const LAYOUT: WorldLayout = WorldLayout {
+        solver: core::mem::offset_of!(Self, params.solver),
+        mode: core::mem::offset_of!(Self, params.mode),
+        twist: core::mem::offset_of!(Self, params.rod.twist),
+        bad_target: core::mem::offset_of!(Self, bad_target),
+        strands: core::mem::offset_of!(Self, strands),
+        colliders: core::mem::offset_of!(Self, colliders),
+        grabs: core::mem::offset_of!(Self, grabs),
+    };
 }
 
 impl<const S: usize, const N: usize, M: Math> Default for World<S, N, M> {

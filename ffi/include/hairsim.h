@@ -34,6 +34,21 @@
  * so that a scene gives the same bits on every target, and inputs computed with fused
  * operations would differ from the host's in the last bit and so would the state hash.
  *
+ * Threads and interrupts: calls on different worlds never meet, and the functions that take
+ * no world (hairsim_params_preset, hairsim_material_human_hair, hairsim_shake_pose,
+ * hairsim_circle_target, hairsim_get_capacity, hairsim_version, hairsim_error_message,
+ * hairsim_set_panic_hook) may run anywhere, an interrupt handler included. Calls on one world
+ * must not overlap: each takes the world for its length, and another call meanwhile (from a
+ * thread or an interrupt) is refused with HAIRSIM_ERROR_BUSY, never blocks and never corrupts
+ * it. So a world shared by threads needs a mutex held around each call (or one task that owns
+ * it), and an interrupt handler that calls on a world must accept BUSY. A step takes a tick's
+ * time (docs/embedding.md): step from a task, not from a high-priority interrupt. A world kept
+ * in RAM across a reset that may have stopped a call needs hairsim_recover before anything
+ * else uses it. Every call first checks the world's structure (its enum bytes, list lengths,
+ * node counts and indices), hairsim_check also its state and rest data: a stray write into the
+ * buffer is refused with HAIRSIM_ERROR_CORRUPT, not read. If the library ever panics (a bug),
+ * it calls the hook hairsim_set_panic_hook set, then stops.
+ *
  * Versions: HAIRSIM_VERSION_MAJOR.MINOR.PATCH is this header's, hairsim_version() the
  * library's. While MAJOR is 0, MINOR changes whenever the C ABI changes. hairsim_init is a
  * macro that passes the header's version and capacities to the library, which refuses a
@@ -75,8 +90,8 @@
  * no fewer than a 32-bit target needs (hairsim_get_capacity gives the running target's own).
  */
 #define HAIRSIM_WORLD_SIZE_FOR(strands, nodes) \
-  ((size_t)1287u + (size_t)343u * (size_t)(nodes) + \
-   (size_t)(strands) * ((size_t)72u + (size_t)120u * (size_t)(nodes)))
+  ((size_t)1291u + (size_t)343u * (size_t)(nodes) + \
+   (size_t)(strands) * ((size_t)76u + (size_t)120u * (size_t)(nodes)))
 /** Bytes of a world buffer at HAIRSIM_STRANDS and HAIRSIM_NODES. */
 #define HAIRSIM_WORLD_SIZE HAIRSIM_WORLD_SIZE_FOR(HAIRSIM_STRANDS, HAIRSIM_NODES)
 /** Alignment of a world buffer, bytes. */
@@ -355,6 +370,14 @@ enum hairsim_error
    * A polyline segment is longer than 1 m.
    */
   HAIRSIM_ERROR_LONG_SEGMENT = 24,
+  /**
+   * The world's bytes are not a world the library wrote: a stray write into the buffer, or
+   * a reset in the middle of a call (`hairsim_check`, `hairsim_recover`;
+   * `hairsim_last_refusal` names the part, argument `world`). Every call but
+   * `hairsim_init`, `hairsim_recover` and `hairsim_last_refusal` refuses the world until
+   * `hairsim_init` makes it anew.
+   */
+  HAIRSIM_ERROR_CORRUPT = 25,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -905,6 +928,12 @@ typedef struct hairsim_refusal {
 } hairsim_refusal;
 
 /**
+ * A function the library calls if it panics (`hairsim_set_panic_hook`), or NULL for none: it
+ * gets the source file (`file_len` bytes, not NUL-terminated) and line.
+ */
+typedef void (*hairsim_panic_hook)(const char *file, size_t file_len, uint32_t line);
+
+/**
  * A head shake: rotation about the unit `axis` through `centre` by
  * `amplitude * sin(2 pi frequency t)`.
  */
@@ -1165,6 +1194,47 @@ hairsim_error hairsim_get_info(struct hairsim_world *world, struct hairsim_world
  * `hairsim_refusal`.
  */
 hairsim_error hairsim_last_refusal(struct hairsim_world *world, struct hairsim_refusal *out);
+
+/**
+ * Checks the world's raw bytes before anything reads them as a world (after a reset in the
+ * middle of a call, or to find a stray write into the buffer): the part every call runs
+ * first (the enum bytes, the lists' lengths, each strand's node count and schedule, each
+ * collider's shape, each grab's status, strand and node, the parameters' ranges), then every
+ * strand's state finite and its rest data unchanged since it was added (a checksum).
+ * `HAIRSIM_ERROR_CORRUPT`, with `hairsim_last_refusal` naming the part and the element, says
+ * the world must be made anew (`hairsim_init`). Costs a pass over every node; the first part
+ * alone, which `hairsim_step` runs, a pass over the lists.
+ *
+ * # Safety
+ * `world` as for `hairsim_init`.
+ */
+hairsim_error hairsim_check(struct hairsim_world *world);
+
+/**
+ * Makes a world usable again after a reset that stopped a call half-way (the world in RAM
+ * that the reset kept): the state word that call left busy is cleared, then the world is
+ * checked as `hairsim_check` checks it. `HAIRSIM_ERROR_OK`: the world steps on from where
+ * the interrupted call left it (a step cut short leaves some strands a step ahead of the
+ * others). `HAIRSIM_ERROR_CORRUPT`: make it anew with `hairsim_init`.
+ *
+ * Call it only where no call on this world can be running: at start-up, before the tasks
+ * and interrupts that use the world start. A call it interrupted would go on with a world
+ * it no longer holds.
+ *
+ * # Safety
+ * `world` as for `hairsim_init`.
+ */
+hairsim_error hairsim_recover(struct hairsim_world *world);
+
+/**
+ * Sets the function the library calls if it panics, and returns the one set before (NULL
+ * for none). The library promises never to panic (it refuses what it cannot take, and checks
+ * a world's bytes before it reads them); a panic is a bug. The hook gets the source file
+ * (`file_len` bytes, not NUL-terminated) and line; it should log them and reset the device.
+ * If it returns, the library stops in an endless loop, as it does without a hook. It may be
+ * called from whatever context called the library, an interrupt included.
+ */
+hairsim_panic_hook hairsim_set_panic_hook(hairsim_panic_hook hook);
 
 /**
  * The head's pose at time `t` (s) of `shake`, computed as the core computes it with the

@@ -34,6 +34,7 @@
 extern crate std;
 
 mod convert;
+mod integrity;
 mod refusal;
 pub mod types;
 
@@ -52,6 +53,7 @@ use hairsim_core::{
 };
 
 use convert::Result;
+use integrity::Checksums;
 use refusal::{Function, Name, Record, Refused};
 pub use types::*;
 
@@ -94,6 +96,8 @@ pub(crate) struct CellOf<const S: usize, const N: usize> {
     /// The outcome of the last call on the world (`hairsim_last_refusal`); only reached
     /// through a [`Lease`].
     record: Record,
+    /// The strands' rest-data checksums (`hairsim_check`); only reached through a [`Lease`].
+    checksums: Checksums<S>,
     /// The world; only reached through a [`Lease`].
     world: World<S, N, DefaultMath>,
 }
@@ -113,6 +117,8 @@ struct Lease<'a> {
     world: &'a mut SimWorld,
     /// The world's record of its last call's outcome.
     record: &'a mut Record,
+    /// The strands' rest-data checksums.
+    checksums: &'a mut Checksums,
 }
 
 impl Drop for Lease<'_> {
@@ -223,13 +229,13 @@ unsafe fn slice<'a, T>(p: *const T, count: usize, argument: Name) -> Result<&'a 
     Ok(unsafe { core::slice::from_raw_parts(p, count) })
 }
 
-/// Takes exclusive use of an initialised world. A refusal here is about the argument
-/// `world`, and nothing can be recorded in it.
+/// Takes the state word of an initialised world: from `IDLE` to `BUSY`. A refusal here is
+/// about the argument `world`, and nothing can be recorded in it.
 ///
 /// # Safety
 /// `world`, if not NULL, must be valid for reads and writes of `HAIRSIM_WORLD_SIZE` bytes for
 /// the length of the call.
-unsafe fn lease<'a>(world: *mut hairsim_world) -> Result<Lease<'a>> {
+unsafe fn take<'a>(world: *mut hairsim_world) -> Result<(&'a AtomicU32, *mut Cell)> {
     let cell = world.cast::<Cell>();
     check_ptr(cell, Name::World)?;
     // SAFETY: `cell` is non-NULL and aligned for `Cell` (checked) and the buffer is valid for
@@ -238,26 +244,51 @@ unsafe fn lease<'a>(world: *mut hairsim_world) -> Result<Lease<'a>> {
     // and in other calls, so shared references to it may coexist.
     let state = unsafe { &*addr_of!((*cell).state) };
     match state.compare_exchange(IDLE, BUSY, Ordering::Acquire, Ordering::Relaxed) {
-        Ok(_) => {}
-        Err(BUSY) => return Err(refused(hairsim_error::Busy, Name::World)),
-        Err(_) => return Err(refused(hairsim_error::NotInitialised, Name::World)),
+        Ok(_) => Ok((state, cell)),
+        Err(BUSY) => Err(refused(hairsim_error::Busy, Name::World)),
+        Err(_) => Err(refused(hairsim_error::NotInitialised, Name::World)),
     }
-    // SAFETY: the state word was `IDLE`, so `hairsim_init` wrote a valid world and record
-    // after it, and this call swapped it to `BUSY`: every other call refuses until the lease
-    // is dropped, so these are the only references to them (fields disjoint from the state
-    // word and from each other), and the caller's other buffers were checked not to overlap
-    // them. A record is integers only: any bytes are one.
-    let (world, record) = unsafe {
-        (
-            &mut *addr_of_mut!((*cell).world),
-            &mut *addr_of_mut!((*cell).record),
-        )
-    };
-    Ok(Lease {
-        state,
-        world,
-        record,
-    })
+}
+
+/// The lease of a cell whose state word this call holds at `BUSY`.
+///
+/// # Safety
+/// `cell` as [`take`] returns it, and its world's bytes passed [`integrity::structure`].
+unsafe fn lease_of<'a>(state: &'a AtomicU32, cell: *mut Cell) -> Lease<'a> {
+    // SAFETY: the state word was `IDLE`, so `hairsim_init` wrote a world, a record and
+    // checksums after it, and this call swapped it to `BUSY`: every other call refuses until
+    // the lease is dropped, so these are the only references to them (fields disjoint from
+    // the state word and from each other), and the caller's other buffers were checked not
+    // to overlap them. A record and checksums are integers only: any bytes are one.
+    unsafe {
+        Lease {
+            state,
+            world: &mut *addr_of_mut!((*cell).world),
+            record: &mut *addr_of_mut!((*cell).record),
+            checksums: &mut *addr_of_mut!((*cell).checksums),
+        }
+    }
+}
+
+/// Takes exclusive use of an initialised world, after the cheap part of its check
+/// ([`integrity::structure`]): a world whose bytes fail it is never read as a `World`, the
+/// refusal (`HAIRSIM_ERROR_CORRUPT`) is recorded for `function`, and the world stays refused
+/// until `hairsim_init`.
+///
+/// # Safety
+/// As [`take`].
+unsafe fn lease<'a>(world: *mut hairsim_world, function: Function) -> Result<Lease<'a>> {
+    // SAFETY: the caller's promise.
+    let (state, cell) = unsafe { take(world) }?;
+    // SAFETY: this call holds the state word: nothing writes the cell meanwhile.
+    if let Err(why) = unsafe { integrity::structure(cell) } {
+        // SAFETY: the record lies in the cell, is integers only, and this call holds it.
+        unsafe { addr_of_mut!((*cell).record).write(Record::of(function, Some(why))) };
+        state.store(IDLE, Ordering::Release);
+        return Err(why);
+    }
+    // SAFETY: the structure passed.
+    Ok(unsafe { lease_of(state, cell) })
 }
 
 /// Runs `f` on the world under a lease, and records the outcome of `function` in the world
@@ -270,9 +301,22 @@ unsafe fn with_world<T>(
     function: Function,
     f: impl FnOnce(&mut SimWorld) -> Result<T>,
 ) -> Result<T> {
+    // SAFETY: the caller's promise.
+    unsafe { with_lease(world, function, |lease| f(lease.world)) }
+}
+
+/// [`with_world`] with the whole lease: the world, its record and checksums.
+///
+/// # Safety
+/// As [`lease`].
+unsafe fn with_lease<T>(
+    world: *mut hairsim_world,
+    function: Function,
+    f: impl FnOnce(&mut Lease<'_>) -> Result<T>,
+) -> Result<T> {
     // SAFETY: the caller's promise is `lease`'s.
-    let lease = unsafe { lease(world) }?;
-    let result = f(lease.world);
+    let mut lease = unsafe { lease(world, function) }?;
+    let result = f(&mut lease);
     *lease.record = Record::of(function, result.as_ref().err().copied());
     result
 }
@@ -285,7 +329,7 @@ unsafe fn with_world<T>(
 unsafe fn refuse(world: *mut hairsim_world, function: Function, why: Refused) -> hairsim_error {
     if why.argument != Name::World {
         // SAFETY: the caller's promise is `lease`'s.
-        if let Ok(lease) = unsafe { lease(world) } {
+        if let Ok(lease) = unsafe { lease(world, function) } {
             *lease.record = Record::of(function, Some(why));
         }
     }
@@ -413,8 +457,11 @@ unsafe fn init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
     // default parameters, not on the stack (`.ci/ffi` checks `hairsim_init`'s frame in the
     // thumbv7em disassembly); a `const` empty world would be a world-sized copy from flash.
     unsafe { ptr::write(addr_of_mut!((*cell).world), SimWorld::new()) };
-    // SAFETY: as the world's, for the record.
-    unsafe { ptr::write(addr_of_mut!((*cell).record), Record::NONE) };
+    // SAFETY: as the world's, for the record and the checksums.
+    unsafe {
+        ptr::write(addr_of_mut!((*cell).record), Record::NONE);
+        ptr::write(addr_of_mut!((*cell).checksums), Checksums::NONE);
+    }
     state.store(IDLE, Ordering::Release);
     hairsim_error::Ok
 }
@@ -551,13 +598,19 @@ pub unsafe extern "C" fn hairsim_add_strand(
         // SAFETY: the caller's promise for `world`.
         Err(why) => return unsafe { refuse(world, F, why) },
     };
-    let add = |w: &mut SimWorld| {
+    let add = |lease: &mut Lease<'_>| {
         let strand = Strand::<NODES>::from_polyline(&polyline[..count], &material)
             .map_err(convert::build_error)?;
-        w.add_strand(strand).map_err(convert::capacity_error)
+        let checksum = strand.rest.checksum();
+        let i = lease
+            .world
+            .add_strand(strand)
+            .map_err(convert::capacity_error)?;
+        lease.checksums.keep(i, checksum);
+        Ok(i)
     };
     // SAFETY: the caller's promise for `world`.
-    match unsafe { with_world(world, F, add) } {
+    match unsafe { with_lease(world, F, add) } {
         // SAFETY: the caller's promise for `index` (checked; the world is no
         // longer borrowed).
         Ok(i) => code(unsafe { write_optional(index, i as u32, Name::Index) }),
@@ -952,15 +1005,96 @@ pub unsafe extern "C" fn hairsim_last_refusal(
         return why.code;
     }
     // SAFETY: the caller's promise for `world`.
-    match unsafe { lease(world) } {
-        Ok(lease) => {
-            let record = *lease.record;
-            drop(lease);
-            // SAFETY: the caller's promise for `out` (checked; the world is no longer borrowed).
-            code(unsafe { write(out, record.to_c(), Name::Out) })
-        }
-        Err(e) => e.code,
+    let (state, cell) = match unsafe { take(world) } {
+        Ok(taken) => taken,
+        Err(e) => return e.code,
+    };
+    // SAFETY: this call holds the state word; the record alone is read (integers: any bytes
+    // are one), not the world, whatever its bytes.
+    let record = unsafe { addr_of!((*cell).record).read() };
+    state.store(IDLE, Ordering::Release);
+    // SAFETY: the caller's promise for `out` (checked; the world is no longer held).
+    code(unsafe { write(out, record.to_c(), Name::Out) })
+}
+
+/// Checks the world's raw bytes before anything reads them as a world (after a reset in the
+/// middle of a call, or to find a stray write into the buffer): the part every call runs
+/// first (the enum bytes, the lists' lengths, each strand's node count and schedule, each
+/// collider's shape, each grab's status, strand and node, the parameters' ranges), then every
+/// strand's state finite and its rest data unchanged since it was added (a checksum).
+/// `HAIRSIM_ERROR_CORRUPT`, with `hairsim_last_refusal` naming the part and the element, says
+/// the world must be made anew (`hairsim_init`). Costs a pass over every node; the first part
+/// alone, which `hairsim_step` runs, a pass over the lists.
+///
+/// # Safety
+/// `world` as for `hairsim_init`.
+#[no_mangle]
+pub unsafe extern "C" fn hairsim_check(world: *mut hairsim_world) -> hairsim_error {
+    let check = |lease: &mut Lease<'_>| integrity::contents(lease.world, lease.checksums);
+    // SAFETY: the caller's promise for `world`.
+    code(unsafe { with_lease(world, Function::Check, check) })
+}
+
+/// Makes a world usable again after a reset that stopped a call half-way (the world in RAM
+/// that the reset kept): the state word that call left busy is cleared, then the world is
+/// checked as `hairsim_check` checks it. `HAIRSIM_ERROR_OK`: the world steps on from where
+/// the interrupted call left it (a step cut short leaves some strands a step ahead of the
+/// others). `HAIRSIM_ERROR_CORRUPT`: make it anew with `hairsim_init`.
+///
+/// Call it only where no call on this world can be running: at start-up, before the tasks
+/// and interrupts that use the world start. A call it interrupted would go on with a world
+/// it no longer holds.
+///
+/// # Safety
+/// `world` as for `hairsim_init`.
+#[no_mangle]
+pub unsafe extern "C" fn hairsim_recover(world: *mut hairsim_world) -> hairsim_error {
+    let cell = world.cast::<Cell>();
+    if let Err(e) = check_ptr(cell, Name::World) {
+        return e.code;
     }
+    // SAFETY: as in `take`: the first field of a valid, aligned cell, only accessed atomically.
+    let state = unsafe { &*addr_of!((*cell).state) };
+    match state.load(Ordering::Acquire) {
+        // Nothing else can be running (the caller's promise): what held the world is gone.
+        BUSY | IDLE => state.store(IDLE, Ordering::Release),
+        _ => return hairsim_error::NotInitialised,
+    }
+    let check = |lease: &mut Lease<'_>| integrity::contents(lease.world, lease.checksums);
+    // SAFETY: the caller's promise for `world`.
+    code(unsafe { with_lease(world, Function::Recover, check) })
+}
+
+/// The firmware's panic hook (`hairsim_set_panic_hook`), as an address (0 for none).
+static PANIC_HOOK: core::sync::atomic::AtomicUsize = core::sync::atomic::AtomicUsize::new(0);
+
+/// Sets the function the library calls if it panics, and returns the one set before (NULL
+/// for none). The library promises never to panic (it refuses what it cannot take, and checks
+/// a world's bytes before it reads them); a panic is a bug. The hook gets the source file
+/// (`file_len` bytes, not NUL-terminated) and line; it should log them and reset the device.
+/// If it returns, the library stops in an endless loop, as it does without a hook. It may be
+/// called from whatever context called the library, an interrupt included.
+#[no_mangle]
+pub extern "C" fn hairsim_set_panic_hook(hook: hairsim_panic_hook) -> hairsim_panic_hook {
+    let new = hook.map_or(0, |f| f as usize);
+    let old = PANIC_HOOK.swap(new, Ordering::AcqRel);
+    panic_hook(old)
+}
+
+/// The hook an address in [`PANIC_HOOK`] stands for.
+fn panic_hook(address: usize) -> hairsim_panic_hook {
+    // SAFETY: every value ever stored in `PANIC_HOOK` is 0 or the address of a
+    // `hairsim_panic_hook` function (`hairsim_set_panic_hook`); an `Option` of a function
+    // pointer is a pointer-sized value with 0 for `None`, and function pointers are `usize`
+    // wide on every target this library builds for.
+    unsafe { core::mem::transmute::<usize, hairsim_panic_hook>(address) }
+}
+
+/// A test build's way to panic (feature `panic-test`): the hook's own test under QEMU.
+#[cfg(feature = "panic-test")]
+#[no_mangle]
+pub extern "C" fn hairsim_test_panic() {
+    panic!("hairsim_test_panic");
 }
 
 /// The head's pose at time `t` (s) of `shake`, computed as the core computes it with the
@@ -1060,16 +1194,26 @@ pub extern "C" fn hairsim_error_message(code: i32) -> *const c_char {
         22 => c"hairsim.h was generated for another HAIRSIM_NODES than the library",
         23 => c"a collider needs HAIRSIM_EFFECT_COLLISIONS on, a grab HAIRSIM_EFFECT_GRABS",
         24 => c"a polyline segment is longer than 1 m (hairsim_last_refusal names it)",
+        25 => {
+            c"the world's bytes are not a world: a stray write or a reset mid-call (init it anew)"
+        }
         _ => c"unknown error code",
     };
     message.as_ptr()
 }
 
 /// The backstop of a library that does not panic: with `panic = "abort"` there is nothing to
-/// unwind, so it stops here. A std binary that links the rlib (feature `std`) uses std's.
+/// unwind, so it calls the firmware's hook, if any (`hairsim_set_panic_hook`), with where it
+/// happened, and stops here. A std binary that links the rlib (feature `std`) uses std's.
 #[cfg(all(not(test), not(feature = "std")))]
 #[panic_handler]
-fn panic(_: &core::panic::PanicInfo) -> ! {
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    if let Some(hook) = panic_hook(PANIC_HOOK.load(Ordering::Acquire)) {
+        let (file, line) = info.location().map_or(("", 0), |l| (l.file(), l.line()));
+        // SAFETY: a function the firmware set for this (`hairsim_set_panic_hook`), given a
+        // pointer and length of a static string.
+        unsafe { hook(file.as_ptr().cast(), file.len(), line) };
+    }
     loop {
         core::hint::spin_loop();
     }

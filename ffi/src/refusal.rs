@@ -47,6 +47,8 @@ names! {
         StrandPositions = c"hairsim_strand_positions",
         StateHash = c"hairsim_state_hash",
         GetInfo = c"hairsim_get_info",
+        Check = c"hairsim_check",
+        Recover = c"hairsim_recover",
     }
 }
 
@@ -108,6 +110,16 @@ names! {
         GrabTargetCount = c"grab_target_count",
         Accelerations = c"accelerations",
         AccelerationCount = c"acceleration_count",
+        Strands = c"strands",
+        Colliders = c"colliders",
+        Grabs = c"grabs",
+        Nodes = c"nodes",
+        Schedule = c"schedule",
+        Status = c"status",
+        Coupling = c"coupling",
+        BadTarget = c"bad_target",
+        State = c"state",
+        Rest = c"rest",
     }
 }
 

@@ -112,8 +112,9 @@ macro_rules! world_sizes {
 /// `(A, B, C, D)` of `A + B N + S (C + D N)`: the bytes a world of `S` strands of `N` nodes
 /// needs at most, measured on this 64-bit host (a 32-bit target's world is no larger: only its
 /// `usize` fields shrink). A world is a fixed part, a scratch space that grows with `N`, and
-/// `S` strands of `C + D N` bytes each (exactly); the fixed part and the scratch space are
-/// rounded to 8 bytes at a few places, so `A + B N` is their upper envelope.
+/// `S` strands of `C + D N` bytes each (exactly: the strand and its rest data's checksum);
+/// the fixed part and the scratch space are rounded to 8 bytes at a few places, so `A + B N`
+/// is their upper envelope.
 fn world_size_formula() -> (usize, usize, usize, usize) {
     let sizes = world_sizes!(
         1 x [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 15, 16, 17, 23, 24, 31, 32, 33, 48, 63, 64,
@@ -125,8 +126,9 @@ fn world_size_formula() -> (usize, usize, usize, usize) {
         4096 x [3, 4096]
     );
     let size = |s, n| sizes.iter().find(|&&(a, b, _)| (a, b) == (s, n)).unwrap().2;
-    // Per strand, from two strand counts at two node counts.
-    let strand = |n| size(2, n) - size(1, n);
+    // Per strand, from the most strands and two at two node counts (a strand's checksum is
+    // 4 bytes: over one strand, the 8-byte rounding hides it).
+    let strand = |n| (size(4096, n) - size(2, n)).div_ceil(4096 - 2);
     let d = (strand(4096) - strand(3)) / (4096 - 3);
     let c = strand(3) - 3 * d;
     // The rest: its slope from the fewest nodes to the most, rounded up, then the least
@@ -553,6 +555,239 @@ fn refusals_name_the_argument_the_field_and_the_element() {
     }
 }
 
+/// The firmware scene built in `storage`, stepped 10 times.
+fn built(storage: &mut Storage) -> *mut hairsim_world {
+    let scene = Scene::firmware();
+    let world = storage.init();
+    build(world, &scene);
+    for k in 0..10 {
+        step(world, &scene, k);
+    }
+    world
+}
+
+/// The world's bytes (inside `storage`, past the state word, record and checksums).
+fn world_bytes(world: *mut hairsim_world) -> *mut u8 {
+    unsafe { world.cast::<u8>().add(core::mem::offset_of!(Cell, world)) }
+}
+
+/// The address of element `i` of the list at `offset` in the world (`T`'s heapless vector).
+unsafe fn element<T, const C: usize>(
+    world: *mut hairsim_world,
+    offset: usize,
+    i: usize,
+) -> *mut u8 {
+    unsafe {
+        let list = &*world_bytes(world).add(offset).cast::<heapless::Vec<T, C>>();
+        list.as_ptr().add(i).cast::<u8>().cast_mut()
+    }
+}
+
+#[test]
+fn check_finds_every_kind_of_corruption_and_init_makes_the_world_anew() {
+    use core::mem::offset_of;
+    use hairsim_core::{Collider, Grab, Strand};
+    let layout = SimWorld::LAYOUT;
+    let mut storage = Storage::new();
+    let world = built(&mut storage);
+    assert_eq!(unsafe { hairsim_check(world) }, E::Ok);
+    let pristine = storage.0.clone();
+    // (what to corrupt, the byte's new value, the part named, its index)
+    type Poke = fn(*mut hairsim_world) -> *mut u8;
+    let cases: [(Poke, u8, &str, u32); 10] = [
+        (
+            |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.solver) },
+            7,
+            "world.solver",
+            u32::MAX,
+        ),
+        (
+            |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.bad_target) },
+            2,
+            "world.bad_target",
+            u32::MAX,
+        ),
+        (
+            |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.twist) },
+            2,
+            "world.rod_twist",
+            u32::MAX,
+        ),
+        (
+            |w| unsafe {
+                element::<Strand<NODES>, STRANDS>(w, SimWorld::LAYOUT.strands, 2)
+                    .add(offset_of!(Strand<NODES>, rest.nodes))
+            },
+            200,
+            "world.nodes",
+            2,
+        ),
+        (
+            |w| unsafe {
+                element::<Strand<NODES>, STRANDS>(w, SimWorld::LAYOUT.strands, 1)
+                    .add(offset_of!(Strand<NODES>, schedule.implicit_bending))
+            },
+            2,
+            "world.schedule",
+            1,
+        ),
+        (
+            |w| unsafe {
+                element::<Collider, HAIRSIM_MAX_COLLIDERS>(w, SimWorld::LAYOUT.colliders, 0)
+                    .add(offset_of!(Collider, shape))
+            },
+            3,
+            "world.shape",
+            0,
+        ),
+        (
+            |w| unsafe {
+                element::<Grab, HAIRSIM_MAX_GRABS>(w, SimWorld::LAYOUT.grabs, 0)
+                    .add(offset_of!(Grab, status))
+            },
+            3,
+            "world.status",
+            0,
+        ),
+        (
+            |w| unsafe {
+                element::<Grab, HAIRSIM_MAX_GRABS>(w, SimWorld::LAYOUT.grabs, 0)
+                    .add(offset_of!(Grab, node))
+            },
+            99,
+            "world.node",
+            0,
+        ),
+        (
+            |w| unsafe {
+                element::<Grab, HAIRSIM_MAX_GRABS>(w, SimWorld::LAYOUT.grabs, 0)
+                    .add(crate::integrity::COUPLING_TAG)
+            },
+            2,
+            "world.coupling",
+            0,
+        ),
+        (
+            |w| unsafe {
+                element::<Strand<NODES>, STRANDS>(w, SimWorld::LAYOUT.strands, 3)
+                    .add(offset_of!(Strand<NODES>, rest.mass) + 4)
+            },
+            0x7f,
+            "world.rest",
+            3,
+        ),
+    ];
+    let _ = layout;
+    for (poke, value, part, index) in cases {
+        storage.0.copy_from_slice(&pristine);
+        unsafe { *poke(world) = value };
+        assert_eq!(unsafe { hairsim_check(world) }, E::Corrupt, "{part}");
+        let (code, what, i) = last(world);
+        assert_eq!(
+            (code, what.as_str(), i),
+            (E::Corrupt as i32, &*format!("hairsim_check {part}"), index)
+        );
+        // Every other call refuses it too (but for rest data, which only the check reads).
+        let stepped = unsafe { hairsim_step(world, &input(identity()), ptr::null_mut()) };
+        assert_eq!(stepped == E::Corrupt, part != "world.rest", "{part}");
+        // `hairsim_init` makes it anew.
+        assert_eq!(
+            unsafe { hairsim_init(world, storage.len()) },
+            E::Ok,
+            "{part}"
+        );
+        assert_eq!(unsafe { hairsim_check(world) }, E::Ok, "{part}");
+    }
+    // A non-finite state: the check names the strand; a step would roll it back.
+    storage.0.copy_from_slice(&pristine);
+    unsafe {
+        let strand = element::<Strand<NODES>, STRANDS>(world, layout.strands, 1);
+        let x = strand
+            .add(offset_of!(Strand<NODES>, state.position))
+            .cast::<f32>();
+        x.write(f32::NAN);
+    }
+    assert_eq!(unsafe { hairsim_check(world) }, E::Corrupt);
+    assert_eq!(last(world).1, "hairsim_check world.state");
+}
+
+/// `integrity::COUPLING_TAG`: an `Option<Coupling>` keeps its variant in its first byte, 0 for
+/// `None` and 1 for `Some`, and its values after it (what rustc does, not what Rust promises).
+#[test]
+fn a_grab_s_coupling_tag_is_the_option_s_first_byte() {
+    use hairsim_core::Coupling;
+    const SIZE: usize = core::mem::size_of::<Option<Coupling>>();
+    // Every byte set first, so that a tag elsewhere would not read as one here.
+    let bytes = |c: Option<Coupling>| {
+        let mut buffer = [0xa5u8; SIZE];
+        unsafe { ptr::write_unaligned(buffer.as_mut_ptr().cast::<Option<Coupling>>(), c) };
+        buffer
+    };
+    assert_eq!(SIZE, 12);
+    assert_eq!(bytes(None)[0], 0);
+    let some = bytes(Some(Coupling::new(f32::from_bits(0x4049_0fdb), 0.0)));
+    assert_eq!(some[0], 1);
+    assert_eq!(some[4..8], 0x4049_0fdbu32.to_ne_bytes());
+    // And back: a first byte of 0 or 1 is the variant.
+    let mut raw = some;
+    let read =
+        |raw: &[u8; SIZE]| unsafe { ptr::read_unaligned(raw.as_ptr().cast::<Option<Coupling>>()) };
+    assert!(read(&raw).is_some());
+    raw[0] = 0;
+    assert!(read(&raw).is_none());
+}
+
+#[test]
+fn recover_clears_a_busy_word_a_reset_left_and_checks_the_world() {
+    let mut storage = Storage::new();
+    let world = built(&mut storage);
+    let state = unsafe { &*world.cast::<AtomicU32>() };
+    // A reset in the middle of a call leaves the word busy: every call is refused.
+    state.store(BUSY, Ordering::SeqCst);
+    assert_eq!(
+        unsafe { hairsim_step(world, &input(identity()), ptr::null_mut()) },
+        E::Busy
+    );
+    assert_eq!(unsafe { hairsim_init(world, storage.len()) }, E::Busy);
+    assert_eq!(unsafe { hairsim_recover(world) }, E::Ok);
+    assert_eq!(last(world).1, "hairsim_recover");
+    assert_eq!(
+        unsafe { hairsim_step(world, &input(identity()), ptr::null_mut()) },
+        E::Ok
+    );
+    // Busy and corrupt: recovered as refused, until `hairsim_init`.
+    state.store(BUSY, Ordering::SeqCst);
+    unsafe { *world_bytes(world).add(SimWorld::LAYOUT.mode) = 9 };
+    assert_eq!(unsafe { hairsim_recover(world) }, E::Corrupt);
+    assert_eq!(last(world).1, "hairsim_recover world.mode");
+    assert_eq!(
+        unsafe { hairsim_step(world, &input(identity()), ptr::null_mut()) },
+        E::Corrupt
+    );
+    assert_eq!(unsafe { hairsim_init(world, storage.len()) }, E::Ok);
+    // Not a world at all.
+    let mut zeroed = Storage::new();
+    assert_eq!(
+        unsafe { hairsim_recover(zeroed.world()) },
+        E::NotInitialised
+    );
+}
+
+#[test]
+fn the_panic_hook_is_set_and_swapped() {
+    type Hook = unsafe extern "C" fn(*const core::ffi::c_char, usize, u32);
+    unsafe extern "C" fn first(_: *const core::ffi::c_char, _: usize, _: u32) {}
+    unsafe extern "C" fn second(_: *const core::ffi::c_char, _: usize, _: u32) {}
+    let (first, second): (Hook, Hook) = (first, second);
+    let address = |hook: hairsim_panic_hook| hook.map(|f| f as usize);
+    assert!(hairsim_set_panic_hook(Some(first)).is_none());
+    assert_eq!(
+        address(hairsim_set_panic_hook(Some(second))),
+        Some(first as usize)
+    );
+    assert_eq!(address(hairsim_set_panic_hook(None)), Some(second as usize));
+}
+
 #[test]
 fn the_firmware_scene_through_the_c_functions_gives_the_core_hash() {
     let scene = Scene::firmware();
@@ -928,7 +1163,7 @@ fn refused_arguments_have_their_codes() {
             let message = core::ffi::CStr::from_ptr(hairsim_error_message(code));
             assert!(!message.is_empty());
             let unknown = message.to_str().unwrap() == "unknown error code";
-            assert_eq!(unknown, !(0..=24).contains(&code), "{code}");
+            assert_eq!(unknown, !(0..=25).contains(&code), "{code}");
         }
     }
 }
@@ -939,8 +1174,8 @@ fn refused_arguments_have_their_codes() {
 #[test]
 fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
     use hairsim_core::{
-        Coupling, Effect, Effects, Grab as CoreGrab, Material as CoreMaterial, Params as CoreParams,
-        Pose, Solver, StepInput, Strand as CoreStrand, Vec3 as CoreVec3,
+        Coupling, Effect, Effects, Grab as CoreGrab, Material as CoreMaterial,
+        Params as CoreParams, Pose, Solver, StepInput, Strand as CoreStrand, Vec3 as CoreVec3,
     };
     let params = CoreParams {
         solver: Solver::Dftl,
@@ -982,12 +1217,18 @@ fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
         damping: 0.01,
     };
     unsafe {
-        assert_eq!(hairsim_configure(world, &convert::params_to_c(&params)), E::Ok);
+        assert_eq!(
+            hairsim_configure(world, &convert::params_to_c(&params)),
+            E::Ok
+        );
         let count = c_points.len();
         let code = hairsim_add_strand(world, c_points.as_ptr(), count, &material, ptr::null_mut());
         assert_eq!(code, E::Ok);
         // 1e6 N/m is past the coupling's range, and the refusal names the field.
-        assert_eq!(hairsim_add_grab(world, &grab, ptr::null_mut()), E::InvalidGrab);
+        assert_eq!(
+            hairsim_add_grab(world, &grab, ptr::null_mut()),
+            E::InvalidGrab
+        );
         let (code, what, _) = last(world);
         assert_eq!(
             (code, what.as_str()),
@@ -1002,7 +1243,10 @@ fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
         let mut input = input(identity());
         input.grab_targets = &t;
         input.grab_target_count = 1;
-        assert_eq!(unsafe { hairsim_step(world, &input, report.as_mut_ptr()) }, E::Ok);
+        assert_eq!(
+            unsafe { hairsim_step(world, &input, report.as_mut_ptr()) },
+            E::Ok
+        );
         core_world.set_grab_target(0, target(k + 1));
         core_world.step(&StepInput {
             head: Pose::IDENTITY,

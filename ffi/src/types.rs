@@ -159,6 +159,12 @@ pub enum hairsim_error {
     EffectOff = 23,
     /// A polyline segment is longer than 1 m.
     LongSegment = 24,
+    /// The world's bytes are not a world the library wrote: a stray write into the buffer, or
+    /// a reset in the middle of a call (`hairsim_check`, `hairsim_recover`;
+    /// `hairsim_last_refusal` names the part, argument `world`). Every call but
+    /// `hairsim_init`, `hairsim_recover` and `hairsim_last_refusal` refuses the world until
+    /// `hairsim_init` makes it anew.
+    Corrupt = 25,
 }
 
 /// The model (`hairsim_params::solver`).
@@ -487,6 +493,11 @@ pub struct hairsim_refusal {
     /// folds at, the grab target or acceleration that is not finite.
     pub index: u32,
 }
+
+/// A function the library calls if it panics (`hairsim_set_panic_hook`), or NULL for none: it
+/// gets the source file (`file_len` bytes, not NUL-terminated) and line.
+pub type hairsim_panic_hook =
+    Option<unsafe extern "C" fn(file: *const core::ffi::c_char, file_len: usize, line: u32)>;
 
 /// The library's build-time capacities and world layout, to check against the header.
 #[repr(C)]

@@ -38,7 +38,7 @@ static const char *name_of(hairsim_error code) {
         "DEGENERATE_SEGMENT", "FOLDED_SEGMENT", "INVALID_MATERIAL", "STRANDS_FULL",
         "COLLIDERS_FULL", "GRABS_FULL", "INVALID_COLLIDER", "INVALID_GRAB", "OVERLAP",
         "VERSION_MISMATCH", "STRANDS_MISMATCH", "NODES_MISMATCH", "EFFECT_OFF",
-        "LONG_SEGMENT",
+        "LONG_SEGMENT", "CORRUPT",
     };
     return code >= 0 && (size_t)code < sizeof names / sizeof names[0] ? names[code] : "?";
 }
@@ -446,6 +446,42 @@ static void reentry(void) {
     EXPECT(HAIRSIM_ERROR_OK, hairsim_state_hash(world, &hash));
 }
 
+static void no_hook(const char *file, size_t file_len, uint32_t line) {
+    (void)file;
+    (void)file_len;
+    (void)line;
+}
+
+/* Integrity: a built world passes the check and recovers; every 7th byte of it changed in turn,
+   a step either runs or refuses the world as corrupt; the panic hook is set and returned. */
+static void integrity(void) {
+    hairsim_world *world = (hairsim_world *)busy_storage;
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_init(world, sizeof busy_storage));
+    EXPECT(HAIRSIM_ERROR_OK, firmware_scene_build(world));
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_check(world));
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_recover(world));
+    static unsigned char copy[HAIRSIM_WORLD_SIZE];
+    memcpy(copy, busy_storage, sizeof copy);
+    unsigned corrupt = 0, other = 0;
+    hairsim_capacity cap;
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_get_capacity(&cap));
+    for (size_t offset = 0; offset < cap.world_size; offset += 7) {
+        memcpy(busy_storage, copy, sizeof copy);
+        busy_storage[offset] ^= 0xA5u;
+        hairsim_error e = firmware_scene_step(world, 0, NULL);
+        corrupt += e == HAIRSIM_ERROR_CORRUPT;
+        other += e != HAIRSIM_ERROR_OK && e != HAIRSIM_ERROR_CORRUPT &&
+                 e != HAIRSIM_ERROR_NOT_INITIALISED && e != HAIRSIM_ERROR_BUSY;
+    }
+    printf("     corruption: every 7th byte of the world changed, %u steps refused as corrupt\n",
+           corrupt);
+    check(corrupt > 0 && other == 0, "a corrupted world steps or is refused as corrupt");
+    memcpy(busy_storage, copy, sizeof copy);
+    EXPECT(HAIRSIM_ERROR_OK, hairsim_check(world));
+    check(hairsim_set_panic_hook(no_hook) == NULL, "no panic hook at first");
+    check(hairsim_set_panic_hook(NULL) == no_hook, "the panic hook set is returned");
+}
+
 static void print_line(const char *text) { printf("%s\n", text); }
 
 /* firmware-c/example.c, as the C firmware runs it: .ci/ffi compares the lines both print. */
@@ -471,6 +507,7 @@ int main(int argc, char **argv) {
     }
     refusals();
     reentry();
+    integrity();
     printf("host C test: %u passed, %u failed\n", passed, failed);
     return failed != 0;
 }

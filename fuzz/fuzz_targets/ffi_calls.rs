@@ -126,6 +126,8 @@ enum Call {
     Capacity(Out),
     Message(i32),
     LastRefusal(WorldArg, Out),
+    Check(WorldArg),
+    Recover(WorldArg),
 }
 
 /// Two zeroed world buffers, as C `static`s are.
@@ -262,7 +264,7 @@ fn vec3(v: [F; 3]) -> hairsim_vec3 {
 
 fn check_code(code: hairsim_error) {
     let c = code as i32;
-    assert!((0..=24).contains(&c), "unknown code {c}");
+    assert!((0..=25).contains(&c), "unknown code {c}");
     let message = unsafe { CStr::from_ptr(hairsim_error_message(c)) };
     assert!(!message.is_empty());
 }
@@ -280,7 +282,9 @@ fuzz_target!(|calls: Vec<Call>| {
             | Call::ReleaseGrab(w, _)
             | Call::Positions(w, ..)
             | Call::StateHash(w, _)
-            | Call::Info(w, _) => Some(*w),
+            | Call::Info(w, _)
+            | Call::Check(w)
+            | Call::Recover(w) => Some(*w),
             Call::Step { world, .. } => Some(*world),
             _ => None,
         };
@@ -577,13 +581,24 @@ unsafe fn call_one(call: &Call, worlds: &mut Worlds, out: &mut OutBuf) -> hairsi
             assert!(!message.is_empty());
             hairsim_error::Ok
         }
+        // A world the calls built is never corrupt, and nothing else holds it.
+        Call::Check(w) => {
+            let code = hairsim_check(worlds.ptr(*w));
+            assert_ne!(code, hairsim_error::Corrupt, "{call:?}");
+            code
+        }
+        Call::Recover(w) => {
+            let code = hairsim_recover(worlds.ptr(*w));
+            assert_ne!(code, hairsim_error::Corrupt, "{call:?}");
+            code
+        }
         Call::LastRefusal(w, o) => {
             let world = worlds.ptr(*w);
             let out = out.ptr::<hairsim_refusal>(*o, worlds, Some(*w));
             let code = hairsim_last_refusal(world, out);
             if code == hairsim_error::Ok {
                 let r = &*out;
-                assert!((0..=24).contains(&r.code), "unknown code {}", r.code);
+                assert!((0..=25).contains(&r.code), "unknown code {}", r.code);
                 for text in [r.function, r.argument, r.field] {
                     assert!(!text.is_null());
                     let _ = CStr::from_ptr(text);
