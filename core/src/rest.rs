@@ -16,44 +16,85 @@ impl<const N: usize> Strand<N> {
     /// material. Checks the node count against `N`, every coordinate, every segment's length
     /// and the material's ranges.
     pub fn from_polyline(points: &[Vec3], material: &Material) -> Result<Self, BuildError> {
-        #[allow(clippy::let_unit_value)]
-        let () = Self::CAPACITY_OK;
-        check_polyline::<N>(points, material)?;
-        let nodes = points.len();
-        let mut rest = RestStrand {
-            nodes,
+        let mut strand = Self::EMPTY;
+        strand.rebuild(points, material)?;
+        Ok(strand)
+    }
+
+    /// No strand: every value zero (the placeholder [`Self::rebuild`] writes over).
+    pub const EMPTY: Strand<N> = Strand {
+        state: StrandState {
+            position: [Vec3::ZERO; N],
+            velocity: [Vec3::ZERO; N],
+            theta: [0.0; N],
+            root_frame: Vec3::ZERO,
+        },
+        rest: RestStrand {
             position: [Vec3::ZERO; N],
             segment_length: [0.0; N],
             mass: [0.0; N],
             inverse_mass: [0.0; N],
-            dftl: DftlRest::from_polyline::<Libm>(&[]),
-            rod: RodRest::compute::<Libm>(&[], 0.0, 1.0, 0.0, 1.0),
-        };
+            dftl: DftlRest {
+                root_tangent: Vec3::ZERO,
+                root_normal: Vec3::ZERO,
+                local_rest: [Vec3::ZERO; N],
+                root_distance: [0.0; N],
+                strain_scale: [0.0; N],
+            },
+            nodes: 0,
+            rod: RodRest {
+                rest_length: [0.0; N],
+                voronoi_length: [0.0; N],
+                inverse_voronoi_length: [0.0; N],
+                bending_stiffness: [0.0; N],
+                minor_axis_penalty: 0.0,
+                twist_stiffness: 0.0,
+                rest_theta: [0.0; N],
+                rest_twist: [0.0; N],
+                rest_twist_rotation: [[0.0; 2]; N],
+                rest_curvature: [[[0.0; 2]; 2]; N],
+                stable_time_step: 0.0,
+            },
+        },
+        schedule: Schedule {
+            implicit_bending: false,
+        },
+    };
+
+    /// [`Self::from_polyline`] written over `self` in place: what a world does to build a
+    /// strand in its own storage, with no strand-sized value on the stack. On an error `self`
+    /// is left part-built (the world drops it).
+    pub fn rebuild(&mut self, points: &[Vec3], material: &Material) -> Result<(), BuildError> {
+        #[allow(clippy::let_unit_value)]
+        let () = Self::CAPACITY_OK;
+        check_polyline::<N>(points, material)?;
+        let nodes = points.len();
+        let rest = &mut self.rest;
+        rest.nodes = nodes;
+        rest.position = [Vec3::ZERO; N];
         rest.position[..nodes].copy_from_slice(points);
+        rest.segment_length = [0.0; N];
+        rest.mass = [0.0; N];
+        rest.inverse_mass = [0.0; N];
         let lambda = material.linear_density();
-        lengths_and_masses(&mut rest, points, lambda)?;
-        rest.dftl = DftlRest::from_polyline::<Libm>(points);
+        lengths_and_masses(rest, points, lambda)?;
+        rest.dftl.fill::<Libm>(points);
         // Segments are checked above: the rod's rest data divides by their lengths.
-        rest.rod = RodRest::compute::<Libm>(
-            points,
+        let stiffness = (
             material.bending_stiffness(),
             material.minor_axis_penalty,
             material.twist_stiffness(),
-            lambda,
         );
-        let mut state = StrandState {
-            position: [Vec3::ZERO; N],
-            velocity: [Vec3::ZERO; N],
-            // The rest material frames: a strand starts at rest for the twist solvers too.
-            theta: rest.rod.rest_theta,
-            root_frame: rest_root_frame::<Libm>(points[0], points[1], rest.segment_length[0]),
-        };
+        rest.rod.fill::<Libm>(points, stiffness, lambda);
+        let state = &mut self.state;
+        state.position = [Vec3::ZERO; N];
         state.position[..nodes].copy_from_slice(points);
-        Ok(Strand {
-            rest,
-            state,
-            schedule: Schedule::default(),
-        })
+        state.velocity = [Vec3::ZERO; N];
+        // The rest material frames: a strand starts at rest for the twist solvers too.
+        state.theta = rest.rod.rest_theta;
+        state.root_frame = rest_root_frame::<Libm>(points[0], points[1], rest.segment_length[0]);
+        self.schedule = Schedule::default();
+        Ok(())
     }
 }
 

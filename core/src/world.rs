@@ -15,7 +15,7 @@ use crate::params::{DftlCoefficients, Params};
 use crate::pipeline::rod::RodScratch;
 use crate::pipeline::{begin, finish, step_strands_with, Inputs, Stepping};
 use crate::report::StepReport;
-use crate::strand::Strand;
+use crate::strand::{Material, Strand};
 
 /// What the caller hands in each tick.
 #[derive(Clone, Copy, Debug)]
@@ -153,6 +153,28 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             .push(strand)
             .map_err(|_| CapacityError::Strands { capacity: S })?;
         Ok(self.strands.len() - 1)
+    }
+
+    /// Adds a strand at rest along `points` of `material` ([`Strand::from_polyline`]), built
+    /// in the world's own storage rather than on the stack and moved in (a strand is `120 N`
+    /// bytes, and firmware stacks are small); returns its index. A refused strand or a full
+    /// world leaves the world unchanged.
+    pub fn add_strand_from_polyline(
+        &mut self,
+        points: &[Vec3],
+        material: &Material,
+    ) -> Result<usize, Error> {
+        let index = self.strands.len();
+        if index == S {
+            return Err(CapacityError::Strands { capacity: S }.into());
+        }
+        // The push cannot fail (checked above), and an empty strand is written in place.
+        let _ = self.strands.push(Strand::EMPTY);
+        if let Err(e) = self.strands[index].rebuild(points, material) {
+            self.strands.truncate(index);
+            return Err(e.into());
+        }
+        Ok(index)
     }
 
     /// `Ok` if `effect` is on, else the error saying that `item` needs it.

@@ -48,9 +48,7 @@ use core::mem::{align_of, size_of};
 use core::ptr::{self, addr_of, addr_of_mut};
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use hairsim_core::{
-    Coupling, DefaultMath, Grab, Material, Math, Params, StepInput, Strand, Vec3, World,
-};
+use hairsim_core::{Coupling, DefaultMath, Grab, Material, Math, Params, StepInput, Vec3, World};
 
 use convert::Result;
 use integrity::Checksums;
@@ -547,20 +545,6 @@ pub unsafe extern "C" fn hairsim_configure(
     code(unsafe { with_world(world, F, configure) })
 }
 
-/// Copies the caller's polyline `points[0 .. count)` (`count` at most `NODES`, checked).
-///
-/// # Safety
-/// `points`, if not NULL, valid for reads of `count` `hairsim_vec3`.
-unsafe fn polyline(points: *const hairsim_vec3, count: usize) -> Result<[Vec3; NODES]> {
-    let mut polyline = [Vec3::ZERO; NODES];
-    // SAFETY: the caller's promise; `count <= NODES`.
-    let given = unsafe { slice(points, count, Name::Points) }?;
-    for (p, c) in polyline.iter_mut().zip(given) {
-        *p = Vec3::new(c.x, c.y, c.z);
-    }
-    Ok(polyline)
-}
-
 /// Adds a strand at rest along the polyline `points[0 .. count)` (root first, in the head's
 /// frame, 3 to `HAIRSIM_NODES` points, each segment from 1e-6 m to 1 m long), of `material`.
 /// Its index goes to `index` if not NULL. A refused point or segment is named by
@@ -587,26 +571,31 @@ pub unsafe extern "C" fn hairsim_add_strand(
             .and(check_optional(index, Name::Index))
             .and(check_disjoint(index, 1, world, Name::Index))
     }
-    // SAFETY: the caller's promises for `material` and `points`; `count <= NODES` (checked).
-    // Both are copied before the world is borrowed.
+    // SAFETY: the caller's promise for `material`; it is copied before the world is
+    // borrowed.
     .and_then(|()| unsafe { read(material, Name::Material) })
     .and_then(|m| convert::material(&m).map_err(|r| r.argument(Name::Material)))
-    // SAFETY: the caller's promise for `points`; `count <= NODES` (checked).
-    .and_then(|m| Ok((m, unsafe { polyline(points, count) }?)));
-    let (material, polyline) = match checked {
+    .and_then(|m| {
+        // SAFETY: the caller's promise for `points`, which nothing writes meanwhile and which
+        // do not overlap the world (checked); `count <= NODES` (checked). Their layout is
+        // `Vec3`'s (asserted at `Checked`), and every bit pattern is an `f32`.
+        let points = unsafe { slice(points.cast::<Vec3>(), count, Name::Points) }?;
+        Ok((m, points))
+    });
+    let (material, points) = match checked {
         Ok(c) => c,
         // SAFETY: the caller's promise for `world`.
         Err(why) => return unsafe { refuse(world, F, why) },
     };
+    // Built in the world's storage: no strand-sized value on the stack.
     let add = |lease: &mut Lease<'_>| {
-        let strand = Strand::<NODES>::from_polyline(&polyline[..count], &material)
-            .map_err(convert::build_error)?;
-        let checksum = strand.rest.checksum();
         let i = lease
             .world
-            .add_strand(strand)
-            .map_err(convert::capacity_error)?;
-        lease.checksums.keep(i, checksum);
+            .add_strand_from_polyline(points, &material)
+            .map_err(|e| convert::add_error(e, hairsim_error::InvalidMaterial))?;
+        lease
+            .checksums
+            .keep(i, lease.world.strands()[i].rest.checksum());
         Ok(i)
     };
     // SAFETY: the caller's promise for `world`.

@@ -22,9 +22,21 @@ impl<const N: usize> DftlRest<N> {
             root_distance: [0.0; N],
             strain_scale: [0.0; N],
         };
+        rest.fill::<M>(points);
+        rest
+    }
+
+    /// [`Self::from_polyline`] written over `self` in place (every field).
+    pub fn fill<M: Math>(&mut self, points: &[Vec3]) {
+        let rest = self;
+        rest.root_tangent = Vec3::X;
+        rest.root_normal = Vec3::Y;
+        rest.local_rest = [Vec3::ZERO; N];
+        rest.root_distance = [0.0; N];
+        rest.strain_scale = [0.0; N];
         let n = points.len().min(N);
         if n < 2 {
-            return rest;
+            return;
         }
         let first = points[1] - points[0];
         let first_length = M::length(first);
@@ -57,7 +69,6 @@ impl<const N: usize> DftlRest<N> {
         for d in &mut rest.root_distance[..n] {
             *d /= total;
         }
-        rest
     }
 }
 

@@ -21,8 +21,6 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         twist_stiffness: R,
         linear_density: R,
     ) -> Self {
-        let nodes = points.len().min(N);
-        let segments = nodes.saturating_sub(1);
         let mut rest = RodRest {
             rest_length: [R::ZERO; N],
             voronoi_length: [R::ZERO; N],
@@ -36,13 +34,39 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
             rest_curvature: [[[R::ZERO; 2]; 2]; N],
             stable_time_step: R::of(f32::INFINITY),
         };
+        let stiffness = (bending_stiffness, minor_axis_penalty, twist_stiffness);
+        rest.fill::<P>(points, stiffness, linear_density);
+        rest
+    }
+
+    /// [`Self::compute`] written over `self` in place (every field), with the stiffnesses
+    /// `(α, µ, β)`: no rest data of a strand's size is built on the stack.
+    pub fn fill<P: Precision<R = R>>(
+        &mut self,
+        points: &[P::V],
+        (bending_stiffness, minor_axis_penalty, twist_stiffness): (R, R, R),
+        linear_density: R,
+    ) {
+        let nodes = points.len().min(N);
+        let segments = nodes.saturating_sub(1);
+        self.rest_length = [R::ZERO; N];
+        self.voronoi_length = [R::ZERO; N];
+        self.inverse_voronoi_length = [R::ZERO; N];
+        self.bending_stiffness = [R::ZERO; N];
+        self.minor_axis_penalty = minor_axis_penalty;
+        self.twist_stiffness = twist_stiffness;
+        self.rest_theta = [R::ZERO; N];
+        self.rest_twist = [R::ZERO; N];
+        self.rest_twist_rotation = [[R::ONE, R::ZERO]; N];
+        self.rest_curvature = [[[R::ZERO; 2]; 2]; N];
+        self.stable_time_step = R::of(f32::INFINITY);
         if nodes < 3 {
-            return rest;
+            return;
         }
-        let shortest = rest.lengths::<P>(points, bending_stiffness);
-        let root_frame = rest_root_frame::<P>(points[0], points[1], rest.rest_length[0]);
-        let frames = RodFrames::<P, N>::compute(&points[..nodes], root_frame, &rest.rest_length);
-        rest.angles_and_curvatures(&frames, segments);
+        let shortest = self.lengths::<P>(points, bending_stiffness);
+        let root_frame = rest_root_frame::<P>(points[0], points[1], self.rest_length[0]);
+        let frames = RodFrames::<P, N>::compute(&points[..nodes], root_frame, &self.rest_length);
+        self.angles_and_curvatures(&frames, segments);
         let stiffest = if minor_axis_penalty > R::ONE {
             minor_axis_penalty * bending_stiffness
         } else {
@@ -50,9 +74,8 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         };
         if stiffest > R::ZERO {
             let half = R::of(0.5);
-            rest.stable_time_step = half * shortest * shortest * P::sqrt(linear_density / stiffest);
+            self.stable_time_step = half * shortest * shortest * P::sqrt(linear_density / stiffest);
         }
-        rest
     }
 
     /// The rest lengths `|ê^j|` and `l̂_i` with their inverses, and each segment's bending
