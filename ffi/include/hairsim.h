@@ -60,12 +60,12 @@
  * 10 rad/s; the slowest step of 200 in fixed-cost mode, and the deepest stack.
  *
  *   strands x nodes  world RAM  stack  rod us  DFTL us
- *     1 x 16            8696  10612     883      513
- *     4 x 16           14632  10612   2,604      695
- *     8 x 16           22552  10612   4,880      938
- *     4 x 32           27800  16244   5,188    1,345
- *     8 x 24           32976  13300   7,144    1,375
- *    16 x 32           74600  16244  18,817    2,748
+ *     1 x 16            8696  10612     884      251
+ *     4 x 16           14632  10612   2,605      434
+ *     8 x 16           22552  10612   4,882      679
+ *     4 x 32           27800  16244   5,194      808
+ *     8 x 24           32976  13300   7,149      983
+ *    16 x 32           74600  16244  18,837    2,195
  */
 
 #ifndef HAIRSIM_H
@@ -1046,7 +1046,8 @@ hairsim_error hairsim_init_versioned(struct hairsim_world *buffer,
  * drag 2e-7 kg/s per node, bending, twist (hair-optimised) and inextensibility (projection
  * capped at 8 iterations, tolerance 1e-6). DFTL (`HAIRSIM_SOLVER_DFTL`, Sanchez-Banderas
  * 2015): gravity, the same drag, inextensibility and shape preservation (s_g 0.0066, s_l
- * 0.022 a millisecond, s_d 0.9). Neither has collisions or grabs: turn
+ * 0.022 a millisecond, s_d 0.9); a strand a grab holds runs the rod's projection, 2 iterations
+ * every step. Neither has collisions or grabs: turn
  * `HAIRSIM_EFFECT_COLLISIONS` or `HAIRSIM_EFFECT_GRABS` on before adding a collider or a grab.
  * An unknown solver is `HAIRSIM_ERROR_OUT_OF_RANGE`.
  *

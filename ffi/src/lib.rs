@@ -469,7 +469,8 @@ unsafe fn init(buffer: *mut hairsim_world, len: usize) -> hairsim_error {
 /// drag 2e-7 kg/s per node, bending, twist (hair-optimised) and inextensibility (projection
 /// capped at 8 iterations, tolerance 1e-6). DFTL (`HAIRSIM_SOLVER_DFTL`, Sanchez-Banderas
 /// 2015): gravity, the same drag, inextensibility and shape preservation (s_g 0.0066, s_l
-/// 0.022 a millisecond, s_d 0.9). Neither has collisions or grabs: turn
+/// 0.022 a millisecond, s_d 0.9); a strand a grab holds runs the rod's projection, 2 iterations
+/// every step. Neither has collisions or grabs: turn
 /// `HAIRSIM_EFFECT_COLLISIONS` or `HAIRSIM_EFFECT_GRABS` on before adding a collider or a grab.
 /// An unknown solver is `HAIRSIM_ERROR_OUT_OF_RANGE`.
 ///
