@@ -558,8 +558,9 @@ def check_drag(page):
 
 def check_dftl_drag(page, samples):
     """DFTL hair as a user meets it: sintel_hair.tfx dropped on the page (DFTL, shape on),
-    settled, a strand pressed and dragged 1.5 cm up and 1 cm sideways: the held node follows
-    the hand (within 2 mm after 0.3 s), the force is nonzero and plotted."""
+    settled, a strand pressed and the pointer moved 1.5 cm up and 1 cm sideways on the screen
+    (the hand moves in the plane facing the camera through the node): the held node follows
+    the hand (most of the way, within 2 mm after 0.3 s), the force is nonzero and plotted."""
     page.drop([(HAIR_FILE, read_sample(samples))])
     status = page.status()
     assert status["solver"] == "dftl", status["solver"]
@@ -582,7 +583,9 @@ def check_dftl_drag(page, samples):
           f" it moved {100 * moved:.2f} cm and is {1000 * lag:.2f} mm from the hand; force {force:.3e} N,"
           f" plotted {status['plotted']['samples']} samples up to {status['plotted']['max']:.3e} N, grab {status['grab']}")
     assert status["grab"] == "held", status["grab"]
-    assert moved > 0.015 and lag < 0.002, "the strand does not follow the hand"
+    dragged = norm(vector(target, before))
+    assert dragged > 0.005, f"the hand moved the target {100 * dragged:.2f} cm only"
+    assert moved > 0.8 * dragged and lag < 0.002, "the strand does not follow the hand"
     assert force > 0 and status["plotted"]["max"] > 0, "no force shown"
     page.b.mouse("mouseReleased", x + 1.0 * per_cm, y - 1.5 * per_cm)
     assert page.status()["grab"] == "none"
