@@ -315,6 +315,8 @@ function numbers() {
     grab_force: s.grab_force,
     grab: s.grab,
     grab_target: s.grab_target,
+    grab_limit: s.grab_limit,
+    grab_coupling: s.grab_coupling,
     held: s.held,
     solver: s.solver,
     effects: s.effects,
