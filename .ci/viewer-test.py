@@ -619,8 +619,9 @@ def check_slip_and_regrab(page):
         page.b.mouse("mouseMoved", *point(pixels))
         return norm(vector(page.status()["grab_target"], nodes[0])) - reach
 
-    # 5 cm past the reach: a bisection on the pointer's distance.
-    low, high = 0.0, 60 * per_cm
+    # 5 cm past the reach: a bisection on the pointer's distance, never so far that the spring
+    # would pass the force limit (K × 15 cm < 1 N) should the page step while it runs.
+    low, high = 0.0, 15 * per_cm
     for _ in range(20):
         middle = (low + high) / 2
         low, high = (middle, high) if pull(middle) < 0.05 else (low, middle)
