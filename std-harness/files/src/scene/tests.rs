@@ -204,8 +204,8 @@ fn material_rod_and_dftl_errors() {
     );
     refused(
         &[],
-        "[material]\nshear_modulus = 1e13\n",
-        "t.toml:13: material.shear_modulus: 10000000000000 is out of range",
+        "[material]\nshear_modulus = 1e14\n",
+        "t.toml:13: material.shear_modulus: 100000000000000 is out of range, allowed 1e7 Pa to 1e13 Pa",
     );
     refused(
         &[],
