@@ -397,6 +397,22 @@ fn refusals_name_the_argument_the_field_and_the_element() {
         expect(E::UnsupportedEffect, "hairsim_configure params.effects", 2);
         assert_eq!(hairsim_configure(world, ptr::null()), E::NullPointer);
         expect(E::NullPointer, "hairsim_configure params", none);
+        let mut info = core::mem::MaybeUninit::<hairsim_world_info>::uninit();
+        assert_eq!(hairsim_get_info(world, info.as_mut_ptr()), E::Ok);
+        let mut d = core::mem::MaybeUninit::<hairsim_params>::uninit();
+        assert_eq!(
+            hairsim_params_preset(hairsim_solver::Dftl as u32, d.as_mut_ptr()),
+            E::Ok
+        );
+        let mut d = d.assume_init();
+        d.wind_direction.x = f32::from_bits(0xFFFF01FD);
+        d.wind_gust = 0.0;
+        assert_eq!(hairsim_configure(world, &d), E::NotFinite);
+        expect(
+            E::NotFinite,
+            "hairsim_configure params.wind_direction",
+            none,
+        );
         assert_eq!(hairsim_configure(world, &scene.params), E::Ok);
         expect(E::Ok, "hairsim_configure", none);
 
