@@ -1285,3 +1285,30 @@ fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
     );
     assert_eq!(hash(world), core_world.state_hash());
 }
+
+/// A refusal on a world fresh from `hairsim_init` is recorded too (found by the `ffi_calls`
+/// fuzz target).
+#[test]
+fn a_refused_configure_right_after_init_is_recorded() {
+    let mut storage = Storage::new();
+    let world = storage.init();
+    unsafe {
+        let mut d = core::mem::MaybeUninit::<hairsim_params>::uninit();
+        assert_eq!(
+            hairsim_params_preset(hairsim_solver::Dftl as u32, d.as_mut_ptr()),
+            E::Ok
+        );
+        let mut d = d.assume_init();
+        d.wind_direction.x = f32::from_bits(0xFFFF01FD);
+        d.wind_gust = 0.0;
+        assert_eq!(hairsim_configure(world, &d), E::NotFinite);
+    }
+    let (code, what, _) = last(world);
+    assert_eq!(
+        (code, what.as_str()),
+        (
+            E::NotFinite as i32,
+            "hairsim_configure params.wind_direction"
+        )
+    );
+}
