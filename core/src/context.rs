@@ -126,22 +126,28 @@ impl StepContext {
         head: Pose,
         colliders: &[Collider],
     ) -> Self {
+        Self::at(params, dftl, (previous_head, head), colliders, 0.0)
+    }
+
+    /// As [`Self::with_coefficients`] for the step ending at time `t` (s; the wind's gusts
+    /// depend on it): `with_coefficients(…).at_time(t)`. One expression, so that each part is
+    /// computed where the context lies: a context (about 400 bytes) built in a local and then
+    /// returned or timed is copied each time, on the Cortex-M4F by a library call.
+    #[must_use]
+    #[inline(always)]
+    pub fn at(
+        params: &Params,
+        dftl: DftlCoefficients,
+        (previous_head, head): (Pose, Pose),
+        colliders: &[Collider],
+        t: Real,
+    ) -> Self {
         let effects = params.effects;
-        let mut placed = [Shape::Plane {
-            point: Vec3::ZERO,
-            normal: Vec3::Y,
-        }; MAX_COLLIDERS];
-        let mut collider_count = 0;
-        if effects.contains(Effect::Collisions) {
-            for (slot, c) in placed.iter_mut().zip(colliders) {
-                *slot = if c.attached_to_head {
-                    c.shape.transformed(&head)
-                } else {
-                    c.shape
-                };
-                collider_count += 1;
-            }
-        }
+        let collider_count = if effects.contains(Effect::Collisions) {
+            colliders.len().min(MAX_COLLIDERS)
+        } else {
+            0
+        };
         StepContext {
             params: *params,
             dt: params.dt,
@@ -154,21 +160,18 @@ impl StepContext {
             } else {
                 Vec3::ZERO
             },
-            colliders: placed,
+            colliders: placed(colliders.get(..collider_count).unwrap_or(&[]), &head),
             collider_count,
-            wind: Vec3::ZERO,
+            wind: wind_at(params, t),
             dftl,
             gates: Gates::of(effects, collider_count),
         }
-        .at_time(0.0)
     }
 
     /// Sets the step's time `t` (its end, s), which the wind's gusts depend on.
     #[must_use]
     pub fn at_time(mut self, t: Real) -> Self {
-        if self.effects.contains(Effect::Wind) {
-            self.wind = crate::wind::wind_acceleration(&self.params.wind, t);
-        }
+        self.wind = wind_at(&self.params, t);
         self
     }
 
@@ -183,5 +186,33 @@ impl StepContext {
     #[must_use]
     pub fn has(&self, effect: Effect) -> bool {
         self.effects.contains(effect)
+    }
+}
+
+/// `colliders` (at most [`MAX_COLLIDERS`]) for a step ending with the head at `head`: the
+/// attached ones moved with it; the unused slots a placeholder plane.
+#[inline(always)]
+fn placed(colliders: &[Collider], head: &Pose) -> [Shape; MAX_COLLIDERS] {
+    let mut placed = [Shape::Plane {
+        point: Vec3::ZERO,
+        normal: Vec3::Y,
+    }; MAX_COLLIDERS];
+    for (slot, c) in placed.iter_mut().zip(colliders) {
+        *slot = if c.attached_to_head {
+            c.shape.transformed(head)
+        } else {
+            c.shape
+        };
+    }
+    placed
+}
+
+/// The wind's acceleration at time `t`, or zero when the effect is off.
+#[inline(always)]
+fn wind_at(params: &Params, t: Real) -> Vec3 {
+    if params.effects.contains(Effect::Wind) {
+        crate::wind::wind_acceleration(&params.wind, t)
+    } else {
+        Vec3::ZERO
     }
 }

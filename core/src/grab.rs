@@ -318,15 +318,16 @@ pub const REACH_SLACK: Real = 1.0e-3;
 /// state (measured in `tests/torture.rs`: chatter 3.5 rad). A target is out of reach when
 /// it is farther from the strand's head-held node 1 (where the head puts it this step), or
 /// from another held grab's target on the same strand, than the rest arc length between the
-/// two nodes, with [`REACH_SLACK`]. `strands[k]` is strand `first_strand + k`.
+/// two nodes, with [`REACH_SLACK`]. `strands[k]` is strand `first_strand + k`; `effects` are
+/// the step's, `head` the pose it ends at.
 pub fn slip_unreachable<const N: usize>(
-    ctx: &crate::context::StepContext,
+    (effects, head): (crate::effects::Effects, &crate::head::Pose),
     grabs: &mut [Grab],
     strands: &[crate::strand::Strand<N>],
     first_strand: u32,
     report: &mut crate::report::StepReport,
 ) {
-    if !ctx.has(crate::effects::Effect::Grabs) {
+    if !effects.contains(crate::effects::Effect::Grabs) {
         return;
     }
     let count = grabs.len().min(MAX_GRABS);
@@ -335,7 +336,7 @@ pub fn slip_unreachable<const N: usize>(
         let Some((rest, root, node_a, target_a)) = held(grabs, a, strands, first_strand) else {
             continue;
         };
-        let anchor = ctx.head.transform_point(root);
+        let anchor = head.transform_point(root);
         if !within_reach(rest, 1, node_a, anchor, target_a) {
             out_of_reach |= 1 << a;
         }

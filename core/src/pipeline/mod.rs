@@ -192,12 +192,18 @@ pub fn begin<const N: usize>(
         world.head
     };
     flag_inactive(world.params, world.colliders, world.grabs, report);
+    slip_unreachable(
+        (world.params.effects, &head),
+        world.grabs,
+        world.strands,
+        0,
+        report,
+    );
     let time = (world.steps + 1) as Real * world.params.dt;
-    let ctx =
-        StepContext::with_coefficients(world.params, world.dftl, world.head, head, world.colliders)
-            .at_time(time);
-    slip_unreachable(&ctx, world.grabs, world.strands, 0, report);
-    ctx
+    let poses = (world.head, head);
+    // The context is the last expression, so that it is built where the caller keeps it (a
+    // local returned is copied, 400 bytes).
+    StepContext::at(world.params, world.dftl, poses, world.colliders, time)
 }
 
 /// Flags colliders and holding grabs whose effect is off: a scene may switch `collisions` or

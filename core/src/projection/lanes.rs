@@ -231,7 +231,8 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
         let source = |l: usize| strands.get(l).filter(|_| taken[l]).unwrap_or(lead);
         let nodes = lead.rest.nodes.min(N);
         self.nodes = nodes;
-        let (shapes, shape_count) = usable_colliders(ctx);
+        let mut shape_count = 0;
+        let shapes = usable_colliders(ctx, &mut shape_count);
         let shapes = shapes.get(..shape_count).unwrap_or(&[]);
         let layout = layout_of(ctx, shape_count);
         for (l, book) in self.lanes.iter_mut().enumerate() {

@@ -170,7 +170,8 @@ pub(crate) fn project_in_mode<M: Math, const N: usize>(
     let held = grabbed_nodes(ctx, grabs, strand_index, n);
     let mut work = Workspace::new(strand, n);
     prescribe_grabs::<M, N>(strand, ctx, grabs, &held, &mut work);
-    let (shapes, shape_count) = usable_colliders(ctx);
+    let mut shape_count = 0;
+    let shapes = usable_colliders(ctx, &mut shape_count);
     let layout = layout_in_mode(ctx, shape_count, mode);
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
     let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
@@ -332,22 +333,26 @@ impl<const N: usize> Workspace<N> {
 }
 
 /// The step's colliders that pass their checks (a bad one can come through `step_strands`),
-/// each with its index in the step's list, packed at the front.
-pub(crate) fn usable_colliders(ctx: &StepContext) -> ([(u8, Shape); MAX_COLLIDERS], usize) {
+/// each with its index in the step's list, packed at the front; how many in `count`. (The
+/// list alone is returned: returned in a pair, it was copied once more on the Cortex-M4F.)
+pub(crate) fn usable_colliders(
+    ctx: &StepContext,
+    count: &mut usize,
+) -> [(u8, Shape); MAX_COLLIDERS] {
     let placeholder = Shape::Plane {
         point: Vec3::ZERO,
         normal: Vec3::Y,
     };
     let mut shapes = [(0, placeholder); MAX_COLLIDERS];
-    let mut count = 0;
+    *count = 0;
     for (c, shape) in ctx.colliders().iter().enumerate().take(MAX_COLLIDERS) {
-        if let (true, Some(slot)) = (shape.is_valid(), shapes.get_mut(count)) {
+        if let (true, Some(slot)) = (shape.is_valid(), shapes.get_mut(*count)) {
             // `c < MAX_COLLIDERS = 8`: fits a u8 and the per-node contact bit mask.
             *slot = (c as u8, *shape);
-            count += 1;
+            *count += 1;
         }
     }
-    (shapes, count)
+    shapes
 }
 
 /// Grabbed nodes: a prescribed one is moved to its target, with infinite mass and no rows
