@@ -509,10 +509,10 @@ def norm(v):
 
 def pixels_per_cm(page, x, y):
     """Pixels per centimetre at the held node's depth, from a small diagonal move of the
-    pointer pressed at (x, y) (the pointer is left there)."""
+    pointer pressed at (x, y), 7 pixels on each axis (the pointer is left there)."""
     start = page.status()["grab_target"]
     page.b.mouse("mouseMoved", x + 7, y - 7)
-    return 7 / (100 * norm(vector(page.status()["grab_target"], start)))
+    return 7 * 2 ** 0.5 / (100 * norm(vector(page.status()["grab_target"], start)))
 
 
 def check_drag(page):
@@ -529,7 +529,8 @@ def check_drag(page):
     first = page.status()
     assert first["grab"] == "held", f"pressing on a strand grabbed nothing: {first['grab']}"
     start = first["grab_target"]
-    per_cm = pixels_per_cm(page, x, y)
+    # Up and to the right on the screen, each axis 1/√2 of the drag.
+    per_cm = pixels_per_cm(page, x, y) / 2 ** 0.5
     magnitudes = []
     for cm in DRAG_CM:
         page.b.mouse("mouseMoved", x + cm * per_cm, y - cm * per_cm)

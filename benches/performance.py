@@ -989,11 +989,12 @@ def latency_section(text):
     return "\n".join(out)
 
 
-FIRMWARE_ROW = re.compile(r"^\| (\w+) \| (\d+) \| ([\d./]+) \| ([\d./]+) \| ([\d.]+) \| (\d+) \| "
+FIRMWARE_ROW = re.compile(r"^\| ([\w-]+) \| (\d+) \| ([\d./]+) \| ([\d./]+) \| ([\d.]+) \| (\d+) \| "
                           r"(yes|no) \|$", re.M)
 QEMU = ["qemu-system-arm", "-cpu", "cortex-m4", "-machine", "mps2-an386", "-nographic",
         "-icount", "shift=0", "-semihosting-config", "enable=on,target=native", "-kernel"]
-SOLVER_NAMES = {"rod": "rod", "dftl": "DFTL + shape", "dftl_noshape": "DFTL, no shape"}
+SOLVER_NAMES = {"rod": "rod", "dftl": "DFTL + shape", "dftl_noshape": "DFTL, no shape",
+                "haptic-dftl": "`haptic-dftl`: DFTL + shape, a coupled grab"}
 
 
 def build_firmware():
@@ -1016,7 +1017,9 @@ def firmware_section(runner):
     intro = ["## Measured on the target: Cortex-M4F under QEMU", "",
              "The firmware example steps rod scenes and DFTL scenes (with shape preservation, "
              "and without) in fixed-cost mode, calm (head still) and violent (head shaking at "
-             "10 rad/s, hair starting horizontal), under `qemu-system-arm -icount shift=0`: "
+             "10 rad/s, hair starting horizontal), and the built-in `haptic-dftl` scene (8 "
+             "strands × 16 nodes, a device holding one tip through a coupling; violent: the "
+             "head shaking, the device going round its circle), under `qemu-system-arm -icount shift=0`: "
              "one instruction per virtual nanosecond, so the counts are deterministic and do "
              "not depend on the host. `firmware/latency.py` turns them into a Cortex-M4F cycle "
              "estimate (1 cycle an instruction, 14 for `VDIV`/`VSQRT`, 3 for the "
@@ -1080,6 +1083,13 @@ def firmware_section(runner):
         f"{size('dftl')}, {verdict(largest.get('dftl', 0) >= 512)}, without shape "
         f"{size('dftl_noshape')}, {verdict(largest.get('dftl_noshape', 0) >= 512)}. "
         "What each model needs at the least: [floors](study/floors.md).")
+    haptic = [row for row in rows if row[0] == SOLVER_NAMES["haptic-dftl"]]
+    if haptic:
+        fits, ratio = haptic[0][6] == "yes", float(haptic[0][4])
+        out_lines[-1] += (
+            f" `haptic-dftl` within half a tick at 168 MHz: {haptic[0][5]} µs, "
+            f"{verdict(fits)}; violent max ÷ calm median ≤ 1.2: {ratio:.3f}, "
+            f"{verdict(ratio <= 1.2)}.")
     collision = collision_rows(out)
     if collision:
         out_lines += ["", "What a collision row costs (`latency.py`'s `collision rows` lines): the "
