@@ -63,6 +63,23 @@ unsafe fn byte(base: *const u8, offset: usize) -> u8 {
     unsafe { base.add(offset).read() }
 }
 
+/// The length a `heapless::Vec` at `list` holds, read from its bytes. `len()` cannot be asked:
+/// it makes a slice of that length first (the list derefs to one), which for a length past
+/// the capacity is undefined behaviour before any comparison. heapless's `VecInner { phantom,
+/// len, buffer }` keeps its buffer, which may be unsized, last, and its marker takes no room:
+/// the length is the list's first `usize` (`LIST_LENGTH`; the tests check it for the three
+/// lists).
+///
+/// # Safety
+/// `list` must be valid for reads of a `usize` and aligned for one.
+unsafe fn stored_length(list: *const u8) -> usize {
+    // SAFETY: the caller's promise; any bytes are a `usize`.
+    unsafe { list.add(LIST_LENGTH).cast::<usize>().read() }
+}
+
+/// Where a `heapless::Vec` keeps its length: its first bytes (see [`stored_length`]).
+pub(crate) const LIST_LENGTH: usize = 0;
+
 /// `Ok` if `ok`, else [`corrupt`].
 fn expect(ok: bool, field: Name, index: Option<usize>) -> Result<(), Refused> {
     if ok {
@@ -92,7 +109,8 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
     }
     // SAFETY: the lists lie at the layout's offsets inside the world, and a `heapless::Vec`'s
     // every byte pattern is a value (its storage is `MaybeUninit`): a reference to one is
-    // sound whatever its bytes, and its length is only compared below.
+    // sound whatever its bytes. Only its capacity and its buffer's address are asked of it;
+    // its length is read from its bytes below.
     let (strands, colliders, grabs) = unsafe {
         (
             &*base.add(layout.strands).cast::<Strands<STRANDS, NODES>>(),
@@ -100,15 +118,23 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
             &*base.add(layout.grabs).cast::<Grabs>(),
         )
     };
-    expect(strands.len() <= strands.capacity(), Name::Strands, None)?;
+    // SAFETY: each list lies at its offset inside the world, aligned for its `usize` length.
+    let (strand_count, collider_count, grab_count) = unsafe {
+        (
+            stored_length(base.add(layout.strands)),
+            stored_length(base.add(layout.colliders)),
+            stored_length(base.add(layout.grabs)),
+        )
+    };
+    expect(strand_count <= strands.capacity(), Name::Strands, None)?;
     expect(
-        colliders.len() <= colliders.capacity(),
+        collider_count <= colliders.capacity(),
         Name::Colliders,
         None,
     )?;
-    expect(grabs.len() <= grabs.capacity(), Name::Grabs, None)?;
+    expect(grab_count <= grabs.capacity(), Name::Grabs, None)?;
     let mut nodes = [0usize; STRANDS];
-    for (i, count) in nodes.iter_mut().enumerate().take(strands.len()) {
+    for (i, count) in nodes.iter_mut().enumerate().take(strand_count) {
         // SAFETY: `i` is below the length, which is at most the capacity: inside the buffer.
         let strand = unsafe { strands.as_ptr().add(i) }.cast::<u8>();
         // SAFETY: the field lies inside the strand; any bytes are a `usize`.
@@ -124,7 +150,7 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
             unsafe { byte(strand, offset_of!(Strand<NODES>, schedule.implicit_bending)) };
         expect(schedule < 2, Name::Schedule, Some(i))?;
     }
-    for i in 0..colliders.len() {
+    for i in 0..collider_count {
         // SAFETY: `i` is below the length, at most the capacity.
         let collider = unsafe { colliders.as_ptr().add(i) }.cast::<u8>();
         // SAFETY: the fields lie inside the collider; a `Shape`'s variant is its first byte.
@@ -137,7 +163,7 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
         expect(shape < 3, Name::Shape, Some(i))?;
         expect(attached < 2, Name::AttachedToHead, Some(i))?;
     }
-    for i in 0..grabs.len() {
+    for i in 0..grab_count {
         // SAFETY: `i` is below the length, at most the capacity.
         let grab = unsafe { grabs.as_ptr().add(i) }.cast::<u8>();
         // SAFETY: the fields lie inside the grab; any bytes are a `u32`.
@@ -151,7 +177,7 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
         };
         expect(status < 3, Name::Status, Some(i))?;
         expect(coupling < 2, Name::Coupling, Some(i))?;
-        expect(strand < strands.len(), Name::Strand, Some(i))?;
+        expect(strand < strand_count, Name::Strand, Some(i))?;
         expect((2..nodes[strand]).contains(&node), Name::Node, Some(i))?;
     }
     // SAFETY: every byte a `World` reads as an enum, a `bool` or a length is right (above):

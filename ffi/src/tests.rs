@@ -1312,3 +1312,59 @@ fn a_refused_configure_right_after_init_is_recorded() {
         )
     );
 }
+
+/// `integrity::LIST_LENGTH`: a `heapless::Vec` keeps its length in its first `usize`, for each
+/// of the world's three lists (where heapless lays it out, which its types imply but do not
+/// promise).
+#[test]
+fn a_list_s_length_is_its_first_word() {
+    let mut storage = Storage::new();
+    let world = built(&mut storage);
+    let mut info = hairsim_world_info::default();
+    assert_eq!(unsafe { hairsim_get_info(world, &mut info) }, E::Ok);
+    let layout = SimWorld::LAYOUT;
+    let stored = |offset: usize| unsafe {
+        world_bytes(world)
+            .add(offset + crate::integrity::LIST_LENGTH)
+            .cast::<usize>()
+            .read()
+    };
+    let counts = (info.strands, info.colliders, info.grabs);
+    assert_eq!(counts, (4, 1, 1));
+    let read = (
+        stored(layout.strands),
+        stored(layout.colliders),
+        stored(layout.grabs),
+    );
+    assert_eq!(read, (4, 1, 1));
+}
+
+/// A list's length past its capacity, even one no slice can have, is refused from its bytes:
+/// asking the list its length would first make a slice of it (found by the `world_bytes`
+/// fuzz target).
+#[test]
+fn a_list_length_no_slice_can_have_is_refused() {
+    let layout = SimWorld::LAYOUT;
+    for (offset, name) in [
+        (layout.strands, "hairsim_check world.strands"),
+        (layout.colliders, "hairsim_check world.colliders"),
+        (layout.grabs, "hairsim_check world.grabs"),
+    ] {
+        for length in [usize::MAX, usize::MAX / 2, 1 << 40] {
+            let mut storage = Storage::new();
+            let world = built(&mut storage);
+            unsafe {
+                world_bytes(world)
+                    .add(offset + crate::integrity::LIST_LENGTH)
+                    .cast::<usize>()
+                    .write(length);
+            }
+            assert_eq!(
+                unsafe { hairsim_check(world) },
+                E::Corrupt,
+                "{name} {length}"
+            );
+            assert_eq!(last(world).1, name);
+        }
+    }
+}
