@@ -397,17 +397,10 @@ fn refusals_name_the_argument_the_field_and_the_element() {
         expect(E::UnsupportedEffect, "hairsim_configure params.effects", 2);
         assert_eq!(hairsim_configure(world, ptr::null()), E::NullPointer);
         expect(E::NullPointer, "hairsim_configure params", none);
-        let mut info = core::mem::MaybeUninit::<hairsim_world_info>::uninit();
-        assert_eq!(hairsim_get_info(world, info.as_mut_ptr()), E::Ok);
-        let mut d = core::mem::MaybeUninit::<hairsim_params>::uninit();
         assert_eq!(
-            hairsim_params_preset(hairsim_solver::Dftl as u32, d.as_mut_ptr()),
-            E::Ok
+            hairsim_configure(world, &dftl_preset_with_a_nan_wind()),
+            E::NotFinite
         );
-        let mut d = d.assume_init();
-        d.wind_direction.x = f32::from_bits(0xFFFF01FD);
-        d.wind_gust = 0.0;
-        assert_eq!(hairsim_configure(world, &d), E::NotFinite);
         expect(
             E::NotFinite,
             "hairsim_configure params.wind_direction",
@@ -1286,23 +1279,26 @@ fn a_coupled_grab_on_dftl_hair_through_the_c_functions() {
     assert_eq!(hash(world), core_world.state_hash());
 }
 
-/// A refusal on a world fresh from `hairsim_init` is recorded too (found by the `ffi_calls`
-/// fuzz target).
+/// DFTL's preset with a NaN (sign and payload set) in its wind direction and no gust.
+fn dftl_preset_with_a_nan_wind() -> hairsim_params {
+    let mut d = core::mem::MaybeUninit::<hairsim_params>::uninit();
+    assert_eq!(
+        unsafe { hairsim_params_preset(hairsim_solver::Dftl as u32, d.as_mut_ptr()) },
+        E::Ok
+    );
+    let mut d = unsafe { d.assume_init() };
+    d.wind_direction.x = f32::from_bits(0xFFFF01FD);
+    d.wind_gust = 0.0;
+    d
+}
+
+/// A refusal on a world fresh from `hairsim_init` is recorded too.
 #[test]
 fn a_refused_configure_right_after_init_is_recorded() {
     let mut storage = Storage::new();
     let world = storage.init();
-    unsafe {
-        let mut d = core::mem::MaybeUninit::<hairsim_params>::uninit();
-        assert_eq!(
-            hairsim_params_preset(hairsim_solver::Dftl as u32, d.as_mut_ptr()),
-            E::Ok
-        );
-        let mut d = d.assume_init();
-        d.wind_direction.x = f32::from_bits(0xFFFF01FD);
-        d.wind_gust = 0.0;
-        assert_eq!(hairsim_configure(world, &d), E::NotFinite);
-    }
+    let d = dftl_preset_with_a_nan_wind();
+    assert_eq!(unsafe { hairsim_configure(world, &d) }, E::NotFinite);
     let (code, what, _) = last(world);
     assert_eq!(
         (code, what.as_str()),
