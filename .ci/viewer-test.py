@@ -19,7 +19,7 @@ protocol through a pipe (no driver, no websocket library).
     it slips at its force limit, is drawn and marked on the plot, and a second press re-grabs
     it;
   - the rod with inextensibility off: stretch and roll-backs shown, "stuck" after a second of
-    every strand rolled back; ticked back on, the hair recovers;
+    strands rolled back at every step; ticked back on, the hair recovers;
   - time: after a 15 s stall (the page's clock moved on at once) the page drops the lag and
     goes on in real time; a scene too heavy for real time says "slow motion";
   - the real-time ratio per scene and solver, asserted >= 0.99 for `firmware`;
@@ -676,8 +676,8 @@ def wait_for(page, predicate, seconds, what):
 
 def check_stall_and_recovery(page):
     """The rod on head-2 with inextensibility unticked: the stretch and the roll-backs show as
-    they happen, and after every strand has been rolled back for a second the page says it is
-    stuck and offers reset. Ticked back on, the hair recovers: within a second no roll-back
+    they happen, and after strands have been rolled back at every step for a second the page says
+    it is stuck and offers reset. Ticked back on, the hair recovers: within a second no roll-back
     and no stretch past 1 %."""
     page.load("head-2")
     page.solver("rod")

@@ -280,7 +280,7 @@ impl Session {
     pub fn take_events(&mut self) -> Value {
         let Events {
             steps,
-            all_rolled_back,
+            rolled_back_min,
             rolled_back_max,
             cap_hits_max,
             max_stretch,
@@ -288,7 +288,7 @@ impl Session {
         } = each!(&mut self.running, s => s.take_events());
         json!({
             "steps": steps,
-            "all_rolled_back": all_rolled_back,
+            "rolled_back_min": rolled_back_min,
             "rolled_back_max": rolled_back_max,
             "cap_hits_max": cap_hits_max,
             "max_stretch": max_stretch,

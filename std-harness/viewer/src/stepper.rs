@@ -58,8 +58,10 @@ pub struct Hand {
 pub struct Events {
     /// Steps taken.
     pub steps: u32,
-    /// Steps in which every strand was rolled back.
-    pub all_rolled_back: u32,
+    /// Fewest strands rolled back in one step (0 without steps): more than none means some
+    /// strand was rolled back at every step, the sign of a simulation that no longer moves
+    /// on (a strand rolled back keeps its last good state, so it is rolled back again).
+    pub rolled_back_min: u32,
     /// Most strands rolled back in one step.
     pub rolled_back_max: u32,
     /// Most strands whose projection hit its iteration cap in one step.
@@ -199,10 +201,14 @@ impl<const N: usize> Stepper<N> {
     fn count_events(&mut self) {
         let report = &self.report;
         let events = &mut self.events;
+        events.rolled_back_min = if events.steps == 0 {
+            report.rolled_back
+        } else {
+            events.rolled_back_min.min(report.rolled_back)
+        };
         events.steps += 1;
         let all = u32::try_from(self.strands.len()).unwrap_or(u32::MAX);
         if report.rolled_back >= all && all > 0 {
-            events.all_rolled_back += 1;
             self.rolled_back.fill(true);
         }
         for &s in &report.rolled_back_strands {

@@ -16,7 +16,8 @@ const clock = new Clock();
 
 // How long a warning stays up after it last happened, ms.
 const WARNING_MS = 1000;
-// Every strand rolled back for this long: the page says the simulation is stuck.
+// Some strand rolled back at every step for this long: the page says the simulation is stuck
+// (a rolled-back strand keeps its last good state, so nothing moves it on).
 const STUCK_MS = 1000;
 // Pixels within which a press grabs a node.
 const GRAB_PIXELS = 12;
@@ -35,6 +36,7 @@ const state = {
   loaded: "",
   warnings: new Map(), // kind -> { text, until }
   stuckSince: null,
+  stuckFewest: 0, // fewest strands rolled back in one step since stuckSince
   slipped: null, // { at: [x, y, z], force }
 };
 
@@ -283,9 +285,10 @@ function readEvents(now) {
     state.slips.push([s.time, e.slipped_at]);
     warn("slip", `the grab slipped, holding ${e.slipped_at.toExponential(2)} N (limit ${s.grab_limit} N): press again to re-grab`, now);
   }
-  const stuck = e.steps > 0 && e.all_rolled_back === e.steps;
+  const stuck = e.steps > 0 && e.rolled_back_min > 0;
   if (!stuck && e.steps > 0) state.stuckSince = null;
-  else if (stuck && state.stuckSince === null) state.stuckSince = now;
+  else if (stuck && state.stuckSince === null) [state.stuckSince, state.stuckFewest] = [now, e.rolled_back_min];
+  else if (stuck) state.stuckFewest = Math.min(state.stuckFewest, e.rolled_back_min);
   return e;
 }
 
@@ -297,7 +300,11 @@ function showWarnings(now) {
   }
   const stuck = state.stuckSince !== null && now - state.stuckSince >= STUCK_MS;
   $("stuck").hidden = !stuck;
-  if (stuck) $("stuck-text").textContent = `Every strand has been rolled back for ${((now - state.stuckSince) / 1000).toFixed(1)} s: the simulation is stuck.`;
+  if (stuck) {
+    const n = state.status ? state.status.strands : 0;
+    const who = state.stuckFewest >= n ? "Every strand has" : `${state.stuckFewest} or more of ${n} strands have`;
+    $("stuck-text").textContent = `${who} been rolled back at every step for ${((now - state.stuckSince) / 1000).toFixed(1)} s: the simulation is stuck.`;
+  }
   const text = lines.join("\n");
   if ($("warnings").textContent !== text) $("warnings").textContent = text;
   $("warnings").hidden = lines.length === 0;
