@@ -61,10 +61,12 @@ pub use params::{DftlCoefficients, DftlParams, Mode, Params, WindParams};
 pub use pipeline::dftl::{step_blocks, step_strands_in_blocks};
 pub use pipeline::rod::RodScratch;
 pub use pipeline::rod_lanes::RodBlockScratch;
+pub use pipeline::StepScratch;
 pub use pipeline::{
     step_strands, step_strands_in_lanes, step_strands_in_lanes_with, step_strands_with,
 };
 pub use projection::project_constraints;
+pub use projection::ProjectionScratch;
 pub use report::{Flags, Stage, StepReport};
 pub use strand::{Material, Strand};
 pub use world::{StepInput, World};

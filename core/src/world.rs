@@ -12,8 +12,7 @@ use crate::grab::{retarget, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{DefaultMath, Math, Vec3};
 use crate::params::{DftlCoefficients, Params};
-use crate::pipeline::rod::RodScratch;
-use crate::pipeline::{begin, finish, step_strands_with, Inputs, Stepping};
+use crate::pipeline::{begin, finish, step_strands_with, Inputs, StepScratch, Stepping};
 use crate::report::StepReport;
 use crate::strand::{Material, Strand};
 
@@ -50,9 +49,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     /// A grab target given since the last step was not finite (and was ignored): the next
     /// step's report flags it.
     bad_target: bool,
-    /// The rod step's scratch space: built here once, never per step (not state: not hashed,
-    /// snapshotted or cloned).
-    scratch: RodScratch<M, N>,
+    /// The solver's scratch space: built here, made anew when `configure` changes the
+    /// solver, never per step (not state: not hashed, snapshotted or cloned).
+    scratch: StepScratch<M, N>,
     math: PhantomData<M>,
 }
 
@@ -60,8 +59,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
 /// start: for a caller that checks a world's raw bytes before it reads them as a `World` (the
 /// C ABI's `hairsim_check`, after a reset in the middle of a call or a stray write). The
 /// enums are one byte, the variant's index (`repr(u8)`): [`Solver`](crate::Solver) and
-/// [`crate::params::Mode`] and [`crate::params::TwistMethod`] below 2; the world's flag of a
-/// bad grab target since the last step is a `bool`. The lists are
+/// [`crate::params::Mode`] and [`crate::params::TwistMethod`] below 2, and the solver's
+/// scratch space's variant ([`StepScratch`]) below 2; the world's flag of a bad grab target
+/// since the last step is a `bool`. The lists are
 /// `heapless::Vec`s ([`Strands`], [`Colliders`], [`Grabs`]): every byte pattern is one, but
 /// their lengths must be at most their capacities before their elements are read. Within
 /// an element, the public fields' offsets are `core::mem::offset_of!`'s: a strand's
@@ -86,6 +86,9 @@ pub struct WorldLayout {
     pub colliders: usize,
     /// The grabs, a [`Grabs`].
     pub grabs: usize,
+    /// The solver's scratch space, whose first byte is its variant, below 2
+    /// ([`StepScratch`](crate::pipeline::StepScratch)).
+    pub scratch: usize,
 }
 
 impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
@@ -98,6 +101,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         strands: core::mem::offset_of!(Self, strands),
         colliders: core::mem::offset_of!(Self, colliders),
         grabs: core::mem::offset_of!(Self, grabs),
+        scratch: core::mem::offset_of!(Self, scratch),
     };
 }
 
@@ -121,7 +125,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             head: Pose::IDENTITY,
             steps: 0,
             bad_target: false,
-            scratch: RodScratch::new(),
+            scratch: StepScratch::for_solver(Params::DEFAULT.solver),
             math: PhantomData,
         }
     }
@@ -136,6 +140,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// Replaces the parameters (time step included) after checking them.
     pub fn configure(&mut self, params: Params) -> Result<(), ParamError> {
         params.validate()?;
+        self.scratch.suit(params.solver);
         self.params = params;
         self.dftl = params.dftl.at_step(params.dt);
         Ok(())

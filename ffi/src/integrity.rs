@@ -7,7 +7,7 @@
 //! one.
 //!
 //! The cheap part ([`structure`]), before any call reads the world: the enum and `bool`
-//! bytes, the lists' lengths, each strand's node count and schedule, each collider's shape and
+//! bytes (the solver's scratch space's variant among them), the lists' lengths, each strand's node count and schedule, each collider's shape and
 //! flag, each grab's status, strand, node and coupling's tag, then the parameters' ranges
 //! (bounding every loop).
 //! The rest ([`contents`], `hairsim_check` only): every strand's state finite and its rest
@@ -103,6 +103,7 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
         (layout.mode, Name::Mode),
         (layout.twist, Name::RodTwist),
         (layout.bad_target, Name::BadTarget),
+        (layout.scratch, Name::Scratch),
     ] {
         // SAFETY: each offset is a field's inside the world.
         expect(unsafe { byte(base, offset) } < 2, field, None)?;

@@ -118,6 +118,7 @@ names! {
         Status = c"status",
         Coupling = c"coupling",
         BadTarget = c"bad_target",
+        Scratch = c"scratch",
         State = c"state",
         Rest = c"rest",
     }

@@ -603,11 +603,17 @@ fn check_finds_every_kind_of_corruption_and_init_makes_the_world_anew() {
     let pristine = storage.0.clone();
     // (what to corrupt, the byte's new value, the part named, its index)
     type Poke = fn(*mut hairsim_world) -> *mut u8;
-    let cases: [(Poke, u8, &str, u32); 10] = [
+    let cases: [(Poke, u8, &str, u32); 11] = [
         (
             |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.solver) },
             7,
             "world.solver",
+            u32::MAX,
+        ),
+        (
+            |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.scratch) },
+            2,
+            "world.scratch",
             u32::MAX,
         ),
         (

@@ -19,7 +19,7 @@ use hairsim_core::pipeline::step_strands_with;
 use hairsim_core::pipeline::{self, Inputs, Stepping};
 use hairsim_core::{
     step_strands, step_strands_in_blocks, step_strands_in_lanes_with, Collider, Grab, Math, Params,
-    Pose, RodBlockScratch, RodScratch, Solver, Stage, StepReport, Strand, Vec3,
+    Pose, RodBlockScratch, Solver, Stage, StepReport, StepScratch, Strand, Vec3,
 };
 use rayon::prelude::*;
 
@@ -262,7 +262,7 @@ enum KeptScratch<M: Math, const N: usize> {
     /// Rod strands in lanes of [`ROD_LANES`].
     Blocks(Box<RodBlockScratch<VectorSqrt<M>, N, ROD_LANES>>),
     /// Rod strands one at a time.
-    PerStrand(Box<RodScratch<M, N>>),
+    PerStrand(Box<StepScratch<M, N>>),
     /// DFTL: none.
     None,
 }
@@ -272,7 +272,9 @@ impl<M: Math, const N: usize> KeptScratch<M, N> {
     fn of(solver: Solver, layout: Layout) -> Self {
         match (solver, layout) {
             (Solver::Rod, Layout::Blocks) => KeptScratch::Blocks(Box::default()),
-            (Solver::Rod, Layout::PerStrand) => KeptScratch::PerStrand(Box::default()),
+            (Solver::Rod, Layout::PerStrand) => {
+                KeptScratch::PerStrand(Box::new(StepScratch::for_solver(Solver::Rod)))
+            }
             (Solver::Dftl, _) => KeptScratch::None,
         }
     }

@@ -34,7 +34,7 @@ use crate::guard::guard;
 use crate::lane::{component_sum, not_finite_sum, Lane, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Mode};
-use crate::projection::project_in_mode;
+use crate::projection::{project_in_mode, project_in_scratch, ProjectionScratch};
 use crate::report::{Stage, StepReport};
 use crate::root_coupling::root_coupling;
 use crate::snapshot::{snapshot, Positions};
@@ -62,18 +62,21 @@ macro_rules! with_effect_switches {
 /// [`Setup::new`] of `ctx` (built once for all strands). `index` is the strand's index in the
 /// whole scene (as in `Grab::strand`); `accelerations` (if any) are the caller's per-node
 /// accelerations for this strand, indexed by node. A strand that a grab holds this step takes
-/// [`step_held_strand`]. Never panics: a strand that writes a non-finite value is rolled
-/// back.
+/// [`step_held_strand`], its projection in `scratch` if the caller keeps one (a `World`
+/// does), else in a workspace on the stack: the same bits. Never panics: a strand that writes
+/// a non-finite value is rolled back.
 pub fn step_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     setup: &Setup,
     ctx: &StepContext,
     (grabs, index): (&[Grab], u32),
     accelerations: Option<&[Vec3]>,
+    scratch: Option<&mut ProjectionScratch<N>>,
     report: &mut StepReport,
 ) {
     if !grabbed_nodes(ctx, grabs, index, strand.rest.nodes.min(N)).is_empty() {
-        return step_held_strand::<M, N>(strand, setup, ctx, (grabs, index), accelerations, report);
+        let at = (grabs, index);
+        return step_held_strand::<M, N>(strand, setup, ctx, at, accelerations, scratch, report);
     }
     // Quarantine: the last good positions.
     let last_good: Positions<N> = snapshot(strand, report);
@@ -111,6 +114,7 @@ fn step_held_strand<M: Math, const N: usize>(
     ctx: &StepContext,
     (grabs, index): (&[Grab], u32),
     accelerations: Option<&[Vec3]>,
+    scratch: Option<&mut ProjectionScratch<N>>,
     report: &mut StepReport,
 ) {
     let last_good: Positions<N> = snapshot(strand, report);
@@ -144,7 +148,11 @@ fn step_held_strand<M: Math, const N: usize>(
     pushed.report(report, ctx.colliders().len(), setup.inv_dt);
     let unprojected_momentum = strand_momentum(strand);
     // Lines 5–8 of Kmoch's Algorithm 1: inextensibility, collisions and the grabs.
-    let outcome = project_in_mode::<M, N>(strand, ctx, (grabs, index), Mode::FixedCost, report);
+    let at = (grabs, index);
+    let outcome = match scratch {
+        Some(work) => project_in_scratch::<M, N>(strand, ctx, at, Mode::FixedCost, work, report),
+        None => project_in_mode::<M, N>(strand, ctx, at, Mode::FixedCost, report),
+    };
     let good = not_finite_sum(roots + pass) == 0.0 && strand.is_finite();
     let rolled_back = guard(strand, &last_good, |_, _| good, index, report);
     if rolled_back {
@@ -477,7 +485,7 @@ pub fn step_strands_in_blocks<M: Math, const W: usize, const N: usize>(
             for (l, strand) in chunk.iter_mut().enumerate() {
                 let at = (grabs, first.wrapping_add(l as u32));
                 let of_strand = of_block.and_then(|a| a.get(l * N..(l + 1) * N));
-                step_strand::<M, N>(strand, &setup, ctx, at, of_strand, report);
+                step_strand::<M, N>(strand, &setup, ctx, at, of_strand, None, report);
             }
         } else {
             block.load_state(chunk);

@@ -29,6 +29,7 @@ use crate::grab::{apply_slips, retarget, slip_unreachable, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Params};
+use crate::projection::ProjectionScratch;
 use crate::report::{Flags, StepReport, STRETCH_LIMIT};
 use crate::strand::Strand;
 use crate::stretch::record_stretch;
@@ -51,14 +52,70 @@ pub fn step_strands<M: Math, const N: usize>(
     step_strands_with::<M, N>(ctx, strands, at, accelerations, None, report);
 }
 
-/// [`step_strands`] with the rod's scratch space kept by the caller (a [`crate::World`] keeps
-/// one), so that no step builds one; `None` builds one for the call if the solver is the rod.
+/// The scratch space of [`step_strands_with`] that its caller keeps from step to step (a
+/// [`crate::World`] keeps one, inside `hairsim_init`'s buffer for the C ABI): the solver's
+/// own, one solver's at a time. Not state: never hashed, snapshotted or cloned (a clone is a
+/// new one), and every value a step reads of it, the step has written.
+///
+/// `repr(u8)`: its first byte is the variant, 0 for the rod's and 1 for DFTL's (for a caller
+/// that checks a world's raw bytes, `crate::world::WorldLayout::scratch`).
+#[repr(u8)]
+pub enum StepScratch<M: Math, const N: usize> {
+    /// The rod's: its frames' buffer and its projection's lanes ([`RodScratch`]).
+    Rod(RodScratch<M, N>) = 0,
+    /// DFTL's: the projection workspace of a strand that a grab holds.
+    Dftl(ProjectionScratch<N>) = 1,
+}
+
+impl<M: Math, const N: usize> StepScratch<M, N> {
+    /// The scratch space of `solver`, before its first use.
+    #[must_use]
+    pub const fn for_solver(solver: Solver) -> Self {
+        match solver {
+            Solver::Rod => StepScratch::Rod(RodScratch::new()),
+            Solver::Dftl => StepScratch::Dftl(ProjectionScratch::new()),
+        }
+    }
+
+    /// Made anew for `solver` if it is another solver's. Where the solver is set (a world's
+    /// `configure`), not in a step: the new value may pass through the stack.
+    pub fn suit(&mut self, solver: Solver) {
+        if self.solver() != solver {
+            *self = Self::for_solver(solver);
+        }
+    }
+
+    /// The solver whose scratch space this is.
+    #[must_use]
+    pub fn solver(&self) -> Solver {
+        match self {
+            StepScratch::Rod(_) => Solver::Rod,
+            StepScratch::Dftl(_) => Solver::Dftl,
+        }
+    }
+}
+
+impl<M: Math, const N: usize> Clone for StepScratch<M, N> {
+    fn clone(&self) -> Self {
+        Self::for_solver(self.solver())
+    }
+}
+
+impl<M: Math, const N: usize> core::fmt::Debug for StepScratch<M, N> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "StepScratch({:?})", self.solver())
+    }
+}
+
+/// [`step_strands`] with the scratch space kept by the caller ([`StepScratch`]), so that no
+/// step builds one. `None`, or another solver's, builds the rod's for the call (if the
+/// solver is the rod) and puts DFTL's held strands' projections on the stack: the same bits.
 pub fn step_strands_with<M: Math, const N: usize>(
     ctx: &StepContext,
     strands: &mut [Strand<N>],
     (first_strand, grabs): (u32, &[Grab]),
     accelerations: Option<&[Vec3]>,
-    scratch: Option<&mut RodScratch<M, N>>,
+    scratch: Option<&mut StepScratch<M, N>>,
     report: &mut StepReport,
 ) {
     let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
@@ -67,8 +124,12 @@ pub fn step_strands_with<M: Math, const N: usize>(
     match ctx.params.solver {
         Solver::Rod if cfg!(feature = "rod") => {
             // One scratch space for all the call's strands.
+            let kept = match scratch {
+                Some(StepScratch::Rod(kept)) => Some(kept),
+                _ => None,
+            };
             let mut own = None;
-            let scratch = scratch.unwrap_or_else(|| own.insert(RodScratch::<M, N>::new()));
+            let scratch = kept.unwrap_or_else(|| own.insert(RodScratch::<M, N>::new()));
             for (k, strand) in strands.iter_mut().enumerate() {
                 let at = (grabs, first_strand + k as u32);
                 rod::step_strand::<M, N>(strand, ctx, at, of_strand(k), scratch, report);
@@ -81,10 +142,15 @@ pub fn step_strands_with<M: Math, const N: usize>(
             // What a DFTL step derives from the context (the head's rotation matrix among it)
             // is the same for every strand: once per block.
             let setup = Setup::new(ctx);
+            let mut held = match scratch {
+                Some(StepScratch::Dftl(kept)) => Some(kept),
+                _ => None,
+            };
             for (k, strand) in strands.iter_mut().enumerate() {
                 let index = first_strand + k as u32;
                 let at = (grabs, index);
-                dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand(k), report);
+                let work = held.as_deref_mut();
+                dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand(k), work, report);
             }
         }
         Solver::Rod | Solver::Dftl => {}

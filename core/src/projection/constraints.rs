@@ -713,7 +713,7 @@ struct Found {
 impl<const N: usize> Rows<N> {
     /// Empties the previous iterate's collision rows (every other node's are empty already).
     #[inline(always)]
-    fn forget_contacts(&mut self) {
+    pub(crate) fn forget_contacts(&mut self) {
         for k in 0..self.contact_count.min(N) {
             if let Some(contacts) = self.contacts.get_mut(usize::from(self.contact_nodes[k])) {
                 (contacts.count, contacts.tentative, contacts.kept) = (0, 0, 0);

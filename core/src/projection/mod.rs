@@ -90,7 +90,28 @@ impl defmt::Format for Outcome {
     }
 }
 
-/// Scratch space of one projection: fixed arrays on the stack, nothing on the heap.
+/// A projection's workspace kept by its caller from step to step (a `World` keeps one for
+/// DFTL's held strands, `pipeline::StepScratch`). [`Workspace::reset`] sets every value a
+/// projection reads before it writes it, so the workspace's past never reaches the bits; a
+/// fresh workspace's zero fills were a tenth of a held strand's projection on the
+/// Cortex-M4F, and its kilobytes a step's deepest stack frame.
+pub struct ProjectionScratch<const N: usize>(Workspace<N>);
+
+impl<const N: usize> ProjectionScratch<N> {
+    /// Before its first use.
+    #[must_use]
+    pub const fn new() -> Self {
+        ProjectionScratch(Workspace::empty())
+    }
+}
+
+impl<const N: usize> Default for ProjectionScratch<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Scratch space of one projection: fixed arrays, nothing on the heap.
 struct Workspace<const N: usize> {
     /// `x_pred`: the positions after integration and root coupling.
     predicted: [Vec3; N],
@@ -146,35 +167,68 @@ pub fn project_constraints<M: Math, const N: usize>(
     project_in_mode::<M, N>(strand, ctx, at, ctx.params.mode, report)
 }
 
-/// [`project_constraints`] in `mode` rather than the scene's: DFTL's held strands always
-/// take the fixed cost (`pipeline::dftl`).
+/// [`project_constraints`] in `mode` rather than the scene's, in a workspace of its own on
+/// the stack.
 pub(crate) fn project_in_mode<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    at: (&[Grab], u32),
+    mode: Mode,
+    report: &mut StepReport,
+) -> Outcome {
+    if !projects(ctx) {
+        return Outcome::default();
+    }
+    let mut work = Workspace::new(strand, strand.rest.nodes.min(N));
+    project_in::<M, N>(strand, ctx, at, mode, &mut work, report)
+}
+
+/// [`project_in_mode`] in the workspace `scratch` its caller keeps (DFTL's held strands, in
+/// fixed-cost mode: `pipeline::dftl`), with the same bits.
+pub(crate) fn project_in_scratch<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    at: (&[Grab], u32),
+    mode: Mode,
+    scratch: &mut ProjectionScratch<N>,
+    report: &mut StepReport,
+) -> Outcome {
+    if !projects(ctx) {
+        return Outcome::default();
+    }
+    scratch.0.reset(strand, strand.rest.nodes.min(N));
+    project_in::<M, N>(strand, ctx, at, mode, &mut scratch.0, report)
+}
+
+/// Whether a projection runs: when any of `inextensibility`, `collisions`, `grabs` is on.
+fn projects(ctx: &StepContext) -> bool {
+    ctx.has(Effect::Inextensibility) || ctx.has(Effect::Collisions) || ctx.has(Effect::Grabs)
+}
+
+/// The projection of `strand` in `work`, set up for it ([`Workspace::new`] or
+/// [`Workspace::reset`]).
+fn project_in<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     (grabs, strand_index): (&[Grab], u32),
     mode: Mode,
+    work: &mut Workspace<N>,
     report: &mut StepReport,
 ) -> Outcome {
     #[allow(clippy::let_unit_value)]
     let () = IndexFits::<N>::OK;
-    let inextensibility = ctx.has(Effect::Inextensibility);
-    let collisions = ctx.has(Effect::Collisions);
-    if !(inextensibility || collisions || ctx.has(Effect::Grabs)) {
-        return Outcome::default();
-    }
     report.ran(Stage::Projection);
-    if collisions {
+    if ctx.has(Effect::Collisions) {
         report.ran(Stage::Collisions);
     }
     let n = strand.rest.nodes.min(N);
     let held = grabbed_nodes(ctx, grabs, strand_index, n);
-    let mut work = Workspace::new(strand, n);
-    prescribe_grabs::<M, N>(strand, ctx, grabs, &held, &mut work);
+    prescribe_grabs::<M, N>(strand, ctx, grabs, &held, work);
     let mut shape_count = 0;
     let shapes = usable_colliders(ctx, &mut shape_count);
     let layout = layout_in_mode(ctx, shape_count, mode);
     let shapes = shapes.get(..shape_count).unwrap_or(&[]);
-    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, &mut work);
+    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, work);
     let findings = Findings {
         touched: &work.contacts.touched,
         max_depth: work.rows.max_depth,
@@ -183,7 +237,7 @@ pub(crate) fn project_in_mode<M: Math, const N: usize>(
     };
     let mut outcome = conclude::<M, N>(strand, &work.predicted, ctx, outcome, findings, report);
     outcome.root_pull = work.root_pull * (ctx.inv_dt * ctx.inv_dt);
-    outcome.grab_felt = record_grabs::<M, N>(strand, ctx, grabs, &held, &work, report);
+    outcome.grab_felt = record_grabs::<M, N>(strand, ctx, grabs, &held, work, report);
     outcome
 }
 
@@ -329,6 +383,47 @@ impl<const N: usize> Workspace<N> {
             collider_push: [Vec3::ZERO; MAX_COLLIDERS],
             truncated: false,
         }
+    }
+
+    /// Before its first use: what [`Self::reset`] expects of a workspace it has not seen.
+    const fn empty() -> Self {
+        Workspace {
+            predicted: [Vec3::ZERO; N],
+            nodes: Nodes {
+                inverse_mass: [0.0; N],
+                count: 0,
+            },
+            contacts: ContactMemory::new(),
+            rows: Rows::new(),
+            band: [[0.0; banded::MAX_HALF_BANDWIDTH + 1]; N],
+            multipliers: [0.0; N],
+            grab_pull: [Vec3::ZERO; MAX_GRABS],
+            root_pull: Vec3::ZERO,
+            step: [Vec3::ZERO; N],
+            trust_radius: 0.0,
+            collider_push: [Vec3::ZERO; MAX_COLLIDERS],
+            truncated: false,
+        }
+    }
+
+    /// As [`Self::new`] for the projection of `strand`, in place: the values a projection
+    /// reads before it writes them are set, the rest left as the last projection left them.
+    /// Each iteration's evaluation empties the rows it reads (`constraints::evaluate`) but
+    /// the nodes' collision rows, which [`Rows::forget_contacts`] empties here as it does
+    /// between iterations (without collision slots no evaluation does); the solve writes
+    /// the band, the multipliers and the moves of the rows and nodes it then reads; the
+    /// contact memory forgets the nodes that touched ([`ContactMemory::forget`]); the sums
+    /// start from zero.
+    fn reset(&mut self, strand: &Strand<N>, n: usize) {
+        self.predicted = strand.state.position;
+        self.nodes = free_nodes(strand, n);
+        self.contacts.forget();
+        self.rows.forget_contacts();
+        self.grab_pull = [Vec3::ZERO; MAX_GRABS];
+        self.root_pull = Vec3::ZERO;
+        self.trust_radius = trust_radius(strand, n);
+        self.collider_push = [Vec3::ZERO; MAX_COLLIDERS];
+        self.truncated = false;
     }
 }
 
