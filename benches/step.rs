@@ -23,7 +23,7 @@ use hairsim::scene::Prepared;
 use hairsim::sim::{scene_inputs, Layout, Sim};
 use hairsim_core::params::TwistMethod;
 use hairsim_core::scenes::firmware;
-use hairsim_core::{Libm, World};
+use hairsim_core::{Libm, StepReport, World};
 
 /// Node capacity of the rod scenes (30 nodes per leader).
 const NODES: usize = 32;
@@ -121,11 +121,12 @@ fn firmware_step(c: &mut Criterion) {
     let mut world: Box<World<{ firmware::STRANDS }, { firmware::NODES }, Libm>> = Box::default();
     firmware::build(&mut world).unwrap();
     let mut k = 0u32;
+    let mut report = StepReport::default();
     c.bench_function("firmware scene step", |b| {
         b.iter(|| {
-            let report = firmware::step(&mut world, k);
+            firmware::step(&mut world, k, &mut report);
             k = k.wrapping_add(1);
-            report
+            report.max_stretch
         })
     });
 }

@@ -220,6 +220,46 @@ impl Default for StepReport {
     }
 }
 
+impl StepReport {
+    /// Back to [`Default`], in place (what [`crate::World::step_into`] starts from): every
+    /// field named, so that a new one cannot be forgotten; assigning a new default would build
+    /// it apart and copy it (on the Cortex-M4F, 370 instructions a step).
+    pub fn clear(&mut self) {
+        let StepReport {
+            stage_runs,
+            flags,
+            iterations_max,
+            iterations_total,
+            cap_hits,
+            residual,
+            dropped_rows,
+            max_stretch,
+            max_contact_stretch,
+            max_penetration,
+            contacts,
+            collision_rows,
+            rolled_back,
+            rolled_back_strands,
+            grab_forces,
+            grabs_slipped,
+            head_force,
+            collider_forces,
+            trace,
+        } = self;
+        *stage_runs = [0; STAGE_COUNT];
+        *flags = Flags::default();
+        (*iterations_max, *iterations_total, *cap_hits, *dropped_rows) = (0, 0, 0, 0);
+        (*residual, *max_stretch, *max_contact_stretch, *max_penetration) = (0.0, 0.0, 0.0, 0.0);
+        (*contacts, *collision_rows, *rolled_back) = (0, 0, 0);
+        rolled_back_strands.clear();
+        *grab_forces = [Vec3::ZERO; MAX_GRABS];
+        *grabs_slipped = 0;
+        *head_force = Vec3::ZERO;
+        *collider_forces = [Vec3::ZERO; MAX_COLLIDERS];
+        *trace = StageTrace::new();
+    }
+}
+
 #[cfg(feature = "defmt")]
 impl defmt::Format for StepReport {
     fn format(&self, f: defmt::Formatter) {

@@ -114,16 +114,18 @@ pub mod firmware {
     /// Builds the scene, runs `steps` steps and returns the state hash.
     pub fn run<M: Math>(world: &mut World<STRANDS, NODES, M>, steps: u32) -> Result<u64, Error> {
         build(world)?;
+        let mut report = StepReport::default();
         for k in 0..steps {
-            step(world, k);
+            step(world, k, &mut report);
         }
         Ok(world.state_hash())
     }
 
-    /// Step `k` (0-based) of the scene: the grab moves, the head shakes.
-    pub fn step<M: Math>(world: &mut World<STRANDS, NODES, M>, k: u32) -> StepReport {
+    /// Step `k` (0-based) of the scene, its report into `report`: the grab moves, the head
+    /// shakes.
+    pub fn step<M: Math>(world: &mut World<STRANDS, NODES, M>, k: u32, report: &mut StepReport) {
         world.set_grab_target(0, grab_target::<M>(k + 1));
-        world.step(&input::<M>(k))
+        world.step_into(&input::<M>(k), report);
     }
 
     /// The head's pose before the first step.
@@ -339,17 +341,19 @@ pub mod haptic_dftl {
         }
     }
 
-    /// Step `k` (0-based) of the scene: the device moves, the head shakes.
-    pub fn step<M: Math>(world: &mut World<STRANDS, NODES, M>, k: u32) -> StepReport {
+    /// Step `k` (0-based) of the scene, its report into `report`: the device moves, the head
+    /// shakes.
+    pub fn step<M: Math>(world: &mut World<STRANDS, NODES, M>, k: u32, report: &mut StepReport) {
         world.set_grab_target(0, grab_target::<M>(k + 1));
-        world.step(&input::<M>(k))
+        world.step_into(&input::<M>(k), report);
     }
 
     /// Builds the scene, runs `steps` steps and returns the state hash.
     pub fn run<M: Math>(world: &mut World<STRANDS, NODES, M>, steps: u32) -> Result<u64, Error> {
         build(world)?;
+        let mut report = StepReport::default();
         for k in 0..steps {
-            step(world, k);
+            step(world, k, &mut report);
         }
         Ok(world.state_hash())
     }

@@ -305,6 +305,15 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// back and named).
     pub fn step(&mut self, input: &StepInput<'_>) -> StepReport {
         let mut report = StepReport::default();
+        self.step_into(input, &mut report);
+        report
+    }
+
+    /// [`Self::step`], its report written over `report`: what a loop that keeps one report
+    /// calls (the report is not copied out: on the Cortex-M4F, the copy was 0.4 % of a
+    /// DFTL step of 8 × 16 nodes).
+    pub fn step_into(&mut self, input: &StepInput<'_>, report: &mut StepReport) {
+        report.clear();
         if core::mem::take(&mut self.bad_target) {
             report.flags.insert(crate::report::Flags::BAD_INPUT);
         }
@@ -322,7 +331,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             grab_targets: &[],
             released: &[],
         };
-        let ctx = begin(world, &inputs, &mut report);
+        let ctx = begin(world, &inputs, report);
         let accelerations = input.accelerations;
         let scratch = Some(&mut self.scratch);
         let at = (0, &self.grabs[..]);
@@ -332,12 +341,11 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             at,
             accelerations,
             scratch,
-            &mut report,
+            report,
         );
-        finish(&mut self.grabs, &mut report);
+        finish(&mut self.grabs, report);
         self.head = ctx.head;
         self.steps += 1;
-        report
     }
 }
 

@@ -12,7 +12,7 @@ use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_semihosting::hprintln;
 use hairsim_core::{
     Collider, Effect, Effects, Math, Mode, Params, Pose, Real, Shake, Shape, Solver, StepInput,
-    Strand, Vec3, World,
+    StepReport, Strand, Vec3, World,
 };
 
 /// Steps measured per scene.
@@ -264,13 +264,13 @@ fn timed_step<const S: usize, const N: usize, M: Math>(
         head,
         accelerations: None,
     };
-    let mut rows = 0;
+    let mut report = StepReport::default();
     let t = ticks(|| {
         step_begins();
-        rows = world.step(&input).collision_rows;
+        world.step_into(&input, &mut report);
         step_ends();
     });
-    (t, rows)
+    (t, report.collision_rows)
 }
 
 /// One strand of `nodes` nodes, 1 cm apart along a great circle 0.2 mm outside the 5 cm head,
@@ -298,6 +298,7 @@ fn add_draped<const S: usize, const N: usize, M: Math>(
 fn measure_haptic_dftl<M: Math>(world: &mut HapticWorld<M>, steps: usize) {
     use hairsim_core::scenes::haptic_dftl;
     let mut line = [(0u32, 0u32, 0u32); 2];
+    let mut report = StepReport::default();
     for (v, violent) in [false, true].into_iter().enumerate() {
         *world = World::new();
         if haptic_dftl::build(world).is_err() {
@@ -311,12 +312,13 @@ fn measure_haptic_dftl<M: Math>(world: &mut HapticWorld<M>, steps: usize) {
             *slot = ticks(|| {
                 step_begins();
                 if violent {
-                    haptic_dftl::step(world, k);
+                    haptic_dftl::step(world, k, &mut report);
                 } else {
-                    world.step(&StepInput {
+                    let still = StepInput {
                         head: Pose::IDENTITY,
                         accelerations: None,
-                    });
+                    };
+                    world.step_into(&still, &mut report);
                 }
                 step_ends();
             });
