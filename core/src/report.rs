@@ -249,7 +249,12 @@ impl StepReport {
         *stage_runs = [0; STAGE_COUNT];
         *flags = Flags::default();
         (*iterations_max, *iterations_total, *cap_hits, *dropped_rows) = (0, 0, 0, 0);
-        (*residual, *max_stretch, *max_contact_stretch, *max_penetration) = (0.0, 0.0, 0.0, 0.0);
+        (
+            *residual,
+            *max_stretch,
+            *max_contact_stretch,
+            *max_penetration,
+        ) = (0.0, 0.0, 0.0, 0.0);
         (*contacts, *collision_rows, *rolled_back) = (0, 0, 0);
         rolled_back_strands.clear();
         *grab_forces = [Vec3::ZERO; MAX_GRABS];

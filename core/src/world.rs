@@ -335,14 +335,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         let accelerations = input.accelerations;
         let scratch = Some(&mut self.scratch);
         let at = (0, &self.grabs[..]);
-        step_strands_with::<M, N>(
-            &ctx,
-            &mut self.strands,
-            at,
-            accelerations,
-            scratch,
-            report,
-        );
+        step_strands_with::<M, N>(&ctx, &mut self.strands, at, accelerations, scratch, report);
         finish(&mut self.grabs, report);
         self.head = ctx.head;
         self.steps += 1;

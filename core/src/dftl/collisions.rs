@@ -8,7 +8,7 @@ use crate::collide::Shape;
 use crate::lane::{Lane, V3};
 use crate::math::{Math, Real, Vec3};
 
-use super::measures::{ColliderPush, Measures};
+use super::measures::Measures;
 
 /// SB15 Algorithm 1 line 20 for one node of mass `mass`: `x` pushed out of each collider in
 /// turn (in the scene's order), each push weighed by the mass into that collider's momentum
@@ -22,7 +22,7 @@ pub fn resolve<M: Math, T: Lane>(
     x: V3<T>,
     (active, mass): (T::Mask, T),
     measures: &mut Measures<T>,
-    collider_push: &mut ColliderPush<T>,
+    collider_push: &mut [V3<T>],
 ) -> (V3<T>, T::Mask) {
     let mut x = x;
     let mut contact = T::mask(false);

@@ -163,8 +163,6 @@ pub struct Tally {
     pub penetration: Real,
     /// Nodes pushed out.
     pub contacts: u32,
-    /// `Σ m Δx^push` per collider.
-    pub collider_push: [Vec3; MAX_COLLIDERS],
     /// `Σ m (v + a Δt) − Σ m v⁺` over the free nodes ([`Momenta::lost`]).
     pub lost: Vec3,
     /// The force the head feels from the strand ([`Tally::head_force`]), N; the report takes
@@ -174,26 +172,25 @@ pub struct Tally {
 
 impl Tally {
     /// One strand's measures as the report gives them (a block builds its lanes' tallies
-    /// from [`Measures::stretches`] of all lanes at once); `momenta` are the free nodes'
-    /// momenta over the pass ([`Momenta`]).
+    /// from [`Measures::stretches`] of all lanes at once); `collider_push` are the pushes on
+    /// the scene's colliders in use (one entry each: [`Tally::head_force`]); `momenta` are
+    /// the free nodes' momenta over the pass ([`Momenta`]).
     #[must_use]
     pub fn from_measures<M: Math>(
         m: &Measures<Real>,
-        collider_push: &ColliderPush<Real>,
+        collider_push: &[V3<Real>],
         momenta: Momenta<Real>,
         inv_dt: Real,
     ) -> Self {
         let (stretch, contact_stretch) = m.stretches::<M>();
-        let collider_push = collider_push.map(Vec3::from);
         let lost = momenta.lost.into();
         Tally {
             stretch,
             contact_stretch,
             penetration: m.penetration,
             contacts: m.contacts as u32,
-            collider_push,
             lost,
-            head_force: Self::head_force(lost, &collider_push, inv_dt),
+            head_force: Self::head_force(lost, collider_push, inv_dt),
         }
     }
 
@@ -202,29 +199,38 @@ impl Tally {
     /// be read off a node; what the held root nodes transmit is the change of the free
     /// nodes' momentum that the external forces and the colliders do not explain, with the
     /// opposite sign: `(Σ m (v + a Δt) − Σ m v⁺)/Δt + Σ m Δx^push/Δt²` (the colliders feel
-    /// `−Σ m Δx^push/Δt²`), `lost` being the difference of the sums ([`Momenta::lost`]). At rest: the weight the strand does not lay on a collider. It
+    /// `−Σ m Δx^push/Δt²`), `lost` being the difference of the sums ([`Momenta::lost`]),
+    /// `collider_push` the pushes on the scene's colliders in use (0 with collisions off: the
+    /// others have none). At rest: the weight the strand does not lay on a collider. It
     /// counts the shape springs' pull (their targets move with the head) and the damping's;
     /// the force a grab's device feels is subtracted by the caller where the strand is held.
     #[must_use]
-    pub fn head_force(lost: Vec3, collider_push: &[Vec3; MAX_COLLIDERS], inv_dt: Real) -> Vec3 {
-        let pushed = collider_push.iter().fold(Vec3::ZERO, |sum, &p| sum + p);
+    pub fn head_force(lost: Vec3, collider_push: &[V3<Real>], inv_dt: Real) -> Vec3 {
+        let pushed = collider_push
+            .iter()
+            .fold(Vec3::ZERO, |sum, &p| sum + Vec3::from(p));
         lost * inv_dt + pushed * (inv_dt * inv_dt)
     }
 
     /// Folds the tally into `report`: maxima and counts, and each collider's contact force
     /// `−Σ m Δx^push / Δt²` (the hair's push on the collider, as the rod solver reports it),
-    /// added strand by strand in strand order, for the scene's first `colliders` colliders (0
-    /// with collisions off; the others have no push to add).
-    pub fn report(&self, report: &mut StepReport, colliders: usize, inv_dt: Real) {
+    /// added strand by strand in strand order, for the scene's colliders in use, whose pushes
+    /// `collider_push` holds (none with collisions off; the others have no push to add).
+    pub fn report(&self, report: &mut StepReport, collider_push: &[V3<Real>], inv_dt: Real) {
         // `Lane::max`, a compare: `f32::max` is a library call on the Cortex-M4F.
         report.max_stretch = Lane::max(report.max_stretch, self.stretch);
         report.max_contact_stretch = Lane::max(report.max_contact_stretch, self.contact_stretch);
         report.max_penetration = Lane::max(report.max_penetration, self.penetration);
         report.contacts += self.contacts;
+        Self::report_pushes(report, collider_push, inv_dt);
+    }
+
+    /// Each collider's contact force `−Σ m Δx^push / Δt²` from `collider_push` into `report`
+    /// ([`Tally::report`]).
+    pub fn report_pushes(report: &mut StepReport, collider_push: &[V3<Real>], inv_dt: Real) {
         let scale = -(inv_dt * inv_dt);
-        let forces = report.collider_forces.iter_mut().zip(self.collider_push);
-        for (force, push) in forces.take(colliders) {
-            *force += push * scale;
+        for (force, &push) in report.collider_forces.iter_mut().zip(collider_push) {
+            *force += Vec3::from(push) * scale;
         }
     }
 }

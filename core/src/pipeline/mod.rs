@@ -29,10 +29,10 @@ use crate::grab::{apply_slips, retarget, slip_unreachable, Grab, GrabStatus};
 use crate::head::Pose;
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Params};
-use crate::projection::ProjectionScratch;
 use crate::report::{Flags, StepReport, STRETCH_LIMIT};
 use crate::strand::Strand;
 use crate::stretch::record_stretch;
+use dftl::DftlScratch;
 use rod::RodScratch;
 use rod_lanes::RodBlockScratch;
 
@@ -63,8 +63,9 @@ pub fn step_strands<M: Math, const N: usize>(
 pub enum StepScratch<M: Math, const N: usize> {
     /// The rod's: its frames' buffer and its projection's lanes ([`RodScratch`]).
     Rod(RodScratch<M, N>) = 0,
-    /// DFTL's: the projection workspace of a strand that a grab holds.
-    Dftl(ProjectionScratch<N>) = 1,
+    /// DFTL's: a strand's pushes on the colliders and the projection workspace of a strand
+    /// that a grab holds ([`dftl::DftlScratch`]).
+    Dftl(DftlScratch<N>) = 1,
 }
 
 impl<M: Math, const N: usize> StepScratch<M, N> {
@@ -73,7 +74,7 @@ impl<M: Math, const N: usize> StepScratch<M, N> {
     pub const fn for_solver(solver: Solver) -> Self {
         match solver {
             Solver::Rod => StepScratch::Rod(RodScratch::new()),
-            Solver::Dftl => StepScratch::Dftl(ProjectionScratch::new()),
+            Solver::Dftl => StepScratch::Dftl(DftlScratch::new()),
         }
     }
 
@@ -142,14 +143,17 @@ pub fn step_strands_with<M: Math, const N: usize>(
             // What a DFTL step derives from the context (the head's rotation matrix among it)
             // is the same for every strand: once per block.
             let setup = Setup::new(ctx);
-            let mut held = match scratch {
+            let mut kept = match scratch {
                 Some(StepScratch::Dftl(kept)) => Some(kept),
                 _ => None,
             };
+            if let Some(kept) = kept.as_deref_mut() {
+                kept.begin();
+            }
             for (k, strand) in strands.iter_mut().enumerate() {
                 let index = first_strand + k as u32;
                 let at = (grabs, index);
-                let work = held.as_deref_mut();
+                let work = kept.as_deref_mut();
                 dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand(k), work, report);
             }
         }
