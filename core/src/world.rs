@@ -59,9 +59,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
 /// start: for a caller that checks a world's raw bytes before it reads them as a `World` (the
 /// C ABI's `hairsim_check`, after a reset in the middle of a call or a stray write). The
 /// enums are one byte, the variant's index (`repr(u8)`): [`Solver`](crate::Solver) and
-/// [`crate::params::Mode`] and [`crate::params::TwistMethod`] below 2, and the solver's
-/// scratch space's variant ([`StepScratch`]) below 2; the world's flag of a bad grab target
-/// since the last step is a `bool`. The lists are
+/// [`crate::params::Mode`] and [`crate::params::TwistMethod`] below 2; the world's flag of a
+/// bad grab target since the last step is a `bool`; the solver's scratch space's variant
+/// ([`StepScratch`]) is a `u32` word below 2. The lists are
 /// `heapless::Vec`s ([`Strands`], [`Colliders`], [`Grabs`]): every byte pattern is one, but
 /// their lengths must be at most their capacities before their elements are read. Within
 /// an element, the public fields' offsets are `core::mem::offset_of!`'s: a strand's
@@ -86,7 +86,7 @@ pub struct WorldLayout {
     pub colliders: usize,
     /// The grabs, a [`Grabs`].
     pub grabs: usize,
-    /// The solver's scratch space, whose first byte is its variant, below 2
+    /// The solver's scratch space, whose first word (a `u32`) is its variant, below 2
     /// ([`StepScratch`](crate::pipeline::StepScratch)).
     pub scratch: usize,
 }
@@ -115,6 +115,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
     /// An empty world with [`Params::DEFAULT`] (the rod's preset; DFTL's in a build without the
     /// rod): usable to initialise a `static`.
     #[must_use]
+    #[inline(always)]
     pub const fn new() -> Self {
         World {
             params: Params::DEFAULT,
@@ -125,7 +126,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
             head: Pose::IDENTITY,
             steps: 0,
             bad_target: false,
-            scratch: StepScratch::for_solver(Params::DEFAULT.solver),
+            scratch: StepScratch::new(),
             math: PhantomData,
         }
     }

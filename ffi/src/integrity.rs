@@ -7,7 +7,7 @@
 //! one.
 //!
 //! The cheap part ([`structure`]), before any call reads the world: the enum and `bool`
-//! bytes (the solver's scratch space's variant among them), the lists' lengths, each strand's node count and schedule, each collider's shape and
+//! bytes and the solver's scratch space's variant word, the lists' lengths, each strand's node count and schedule, each collider's shape and
 //! flag, each grab's status, strand, node and coupling's tag, then the parameters' ranges
 //! (bounding every loop).
 //! The rest ([`contents`], `hairsim_check` only): every strand's state finite and its rest
@@ -103,11 +103,14 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
         (layout.mode, Name::Mode),
         (layout.twist, Name::RodTwist),
         (layout.bad_target, Name::BadTarget),
-        (layout.scratch, Name::Scratch),
     ] {
         // SAFETY: each offset is a field's inside the world.
         expect(unsafe { byte(base, offset) } < 2, field, None)?;
     }
+    // SAFETY: the scratch space's variant is a `u32` at its offset inside the world, aligned
+    // (the enum is `repr(u32)`); any bytes are a `u32`.
+    let scratch = unsafe { base.add(layout.scratch).cast::<u32>().read() };
+    expect(scratch < 2, Name::Scratch, None)?;
     // SAFETY: the lists lie at the layout's offsets inside the world, and a `heapless::Vec`'s
     // every byte pattern is a value (its storage is `MaybeUninit`): a reference to one is
     // sound whatever its bytes. Only its capacity and its buffer's address are asked of it;

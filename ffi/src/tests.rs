@@ -611,8 +611,9 @@ fn check_finds_every_kind_of_corruption_and_init_makes_the_world_anew() {
             u32::MAX,
         ),
         (
-            |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.scratch) },
-            2,
+            // The variant's word's last byte: 1 << 24 is no variant either.
+            |w| unsafe { world_bytes(w).add(SimWorld::LAYOUT.scratch + 3) },
+            1,
             "world.scratch",
             u32::MAX,
         ),

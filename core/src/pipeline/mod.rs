@@ -57,9 +57,11 @@ pub fn step_strands<M: Math, const N: usize>(
 /// own, one solver's at a time. Not state: never hashed, snapshotted or cloned (a clone is a
 /// new one), and every value a step reads of it, the step has written.
 ///
-/// `repr(u8)`: its first byte is the variant, 0 for the rod's and 1 for DFTL's (for a caller
-/// that checks a world's raw bytes, `crate::world::WorldLayout::scratch`).
-#[repr(u8)]
+/// `repr(u32)`: its first word is the variant, 0 for the rod's and 1 for DFTL's (for a caller
+/// that checks a world's raw bytes, `crate::world::WorldLayout::scratch`). A word, not a
+/// byte: with a byte and three of padding before the payload, a world built in place built
+/// its scratch space on the stack and copied it (3 KB at 16 nodes).
+#[repr(u32)]
 pub enum StepScratch<M: Math, const N: usize> {
     /// The rod's: its frames' buffer and its projection's lanes ([`RodScratch`]).
     Rod(RodScratch<M, N>) = 0,
@@ -69,20 +71,39 @@ pub enum StepScratch<M: Math, const N: usize> {
 }
 
 impl<M: Math, const N: usize> StepScratch<M, N> {
+    /// The scratch space of [`Params::DEFAULT`]'s solver, before its first use (one variant
+    /// named, not chosen by a `match`: so that a world built in place builds it in place).
+    #[cfg(feature = "rod")]
+    #[inline(always)]
+    #[must_use]
+    pub const fn new() -> Self {
+        StepScratch::Rod(RodScratch::new())
+    }
+
+    /// The scratch space of [`Params::DEFAULT`]'s solver, DFTL in a build without the rod.
+    #[cfg(not(feature = "rod"))]
+    #[inline(always)]
+    #[must_use]
+    pub const fn new() -> Self {
+        StepScratch::Dftl(DftlScratch::new())
+    }
+
     /// The scratch space of `solver`, before its first use.
     #[must_use]
-    pub const fn for_solver(solver: Solver) -> Self {
-        match solver {
-            Solver::Rod => StepScratch::Rod(RodScratch::new()),
-            Solver::Dftl => StepScratch::Dftl(DftlScratch::new()),
-        }
+    pub fn for_solver(solver: Solver) -> Self {
+        let mut scratch = Self::new();
+        scratch.suit(solver);
+        scratch
     }
 
     /// Made anew for `solver` if it is another solver's. Where the solver is set (a world's
-    /// `configure`), not in a step: the new value may pass through the stack.
+    /// `configure`), not in a step; each variant is written where it lives (chosen by a
+    /// `match` and then written, it passed through the stack: 6 KB at 16 nodes).
     pub fn suit(&mut self, solver: Solver) {
-        if self.solver() != solver {
-            *self = Self::for_solver(solver);
+        match (solver, &*self) {
+            (Solver::Rod, StepScratch::Dftl(_)) => *self = StepScratch::Rod(RodScratch::new()),
+            (Solver::Dftl, StepScratch::Rod(_)) => *self = StepScratch::Dftl(DftlScratch::new()),
+            _ => {}
         }
     }
 
@@ -123,22 +144,26 @@ pub fn step_strands_with<M: Math, const N: usize>(
     // A solver this build leaves out (`Solver::is_built`) steps nothing: `Params::validate`
     // refused it, and its code is not linked.
     match ctx.params.solver {
-        Solver::Rod if cfg!(feature = "rod") => {
+        Solver::Rod if cfg!(feature = "rod") => match scratch {
             // One scratch space for all the call's strands.
-            let kept = match scratch {
-                Some(StepScratch::Rod(kept)) => Some(kept),
-                _ => None,
-            };
-            let mut own = None;
-            let scratch = kept.unwrap_or_else(|| own.insert(RodScratch::<M, N>::new()));
-            for (k, strand) in strands.iter_mut().enumerate() {
-                let at = (grabs, first_strand + k as u32);
-                rod::step_strand::<M, N>(strand, ctx, at, of_strand(k), scratch, report);
-                if !ctx.gates.projection {
-                    record_stretch::<M, N>(strand, report);
-                }
+            Some(StepScratch::Rod(kept)) => {
+                step_rod_strands::<M, N>(
+                    ctx,
+                    strands,
+                    (first_strand, grabs),
+                    accelerations,
+                    kept,
+                    report,
+                );
             }
-        }
+            _ => step_rod_strands_in_own::<M, N>(
+                ctx,
+                strands,
+                (first_strand, grabs),
+                accelerations,
+                report,
+            ),
+        },
         Solver::Dftl if cfg!(feature = "dftl") => {
             // What a DFTL step derives from the context (the head's rotation matrix among it)
             // is the same for every strand: once per block.
@@ -159,6 +184,40 @@ pub fn step_strands_with<M: Math, const N: usize>(
         }
         Solver::Rod | Solver::Dftl => {}
     }
+}
+
+/// The rod's strands of [`step_strands_with`] in the scratch space `scratch`.
+#[inline(always)]
+fn step_rod_strands<M: Math, const N: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    (first_strand, grabs): (u32, &[Grab]),
+    accelerations: Option<&[Vec3]>,
+    scratch: &mut RodScratch<M, N>,
+    report: &mut StepReport,
+) {
+    for (k, strand) in strands.iter_mut().enumerate() {
+        let at = (grabs, first_strand + k as u32);
+        let of_strand = accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
+        rod::step_strand::<M, N>(strand, ctx, at, of_strand, scratch, report);
+        if !ctx.gates.projection {
+            record_stretch::<M, N>(strand, report);
+        }
+    }
+}
+
+/// [`step_rod_strands`] in a scratch space of the call's own: out of line, so that its
+/// kilobytes are on the stack only when the caller keeps none.
+#[inline(never)]
+fn step_rod_strands_in_own<M: Math, const N: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    at: (u32, &[Grab]),
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
+    let mut own = RodScratch::<M, N>::new();
+    step_rod_strands::<M, N>(ctx, strands, at, accelerations, &mut own, report);
 }
 
 /// [`step_strands`] with the rod's strands stepped `W` at a time in lanes
