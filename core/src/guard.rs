@@ -10,7 +10,7 @@
 
 use crate::math::Real;
 use crate::report::{Stage, StepReport};
-use crate::snapshot::{LastGood, Strands};
+use crate::snapshot::{Restore, Strands};
 use crate::strand::Strand;
 
 /// How far past its arc length a node of an inextensible strand may lie from the root before
@@ -24,7 +24,7 @@ pub const REACH_FACTOR: Real = 2.0;
 /// `good(strands, k)` goes back to `last_good` at rest, and the report names it as strand
 /// `first + k`. Returns whether any strand rolled back.
 #[inline(always)]
-pub fn guard<S: Strands, K: LastGood<S>>(
+pub fn guard<S: Strands, K: Restore<S>>(
     strands: &mut S,
     last_good: &K,
     good: impl Fn(&S, usize) -> bool,

@@ -25,7 +25,7 @@
 use crate::lane::{Lane, Wide, WideMask, V3};
 use crate::math::{Real, Vec3};
 use crate::root_coupling::Roots;
-use crate::snapshot::{LastGood, Strands};
+use crate::snapshot::{LastGood, Restore, Strands};
 use crate::strand::Strand;
 
 use super::node::NodeInput;
@@ -329,7 +329,9 @@ impl<const W: usize, const N: usize> LastGood<DftlBlock<W, N>> for BlockState<W,
     fn keep(block: &DftlBlock<W, N>) -> Self {
         BlockState(block.state)
     }
+}
 
+impl<const W: usize, const N: usize> Restore<DftlBlock<W, N>> for BlockState<W, N> {
     #[inline(always)]
     fn restore(&self, block: &mut DftlBlock<W, N>, l: usize) {
         let nodes = block.max_nodes.min(N);

@@ -29,7 +29,7 @@ use crate::dftl::measures::{ColliderPush, Measures, Momenta, Tally};
 use crate::dftl::node::{Advanced, Chain, NodeInput, Setup};
 use crate::dftl::velocity::Pending;
 use crate::dftl::{collisions, damping, follow_leader, frame, predict, shape};
-use crate::grab::{forces_after_roll_back, grabbed_nodes, Grab};
+use crate::grab::{forces_after_roll_back, grabbed_nodes, Grab, MAX_GRABS};
 use crate::guard::guard;
 use crate::lane::{component_sum, not_finite_sum, Lane, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
@@ -38,7 +38,7 @@ use crate::projection::{project_in_mode, project_in_scratch, ProjectionScratch};
 
 use crate::report::{Stage, StepReport};
 use crate::root_coupling::root_coupling;
-use crate::snapshot::{snapshot, Positions};
+use crate::snapshot::{snapshot, snapshot_as_passed, PassedPositions};
 use crate::strand::{RestStrand, Strand, StrandState};
 
 /// Calls `pass::<…, SHAPE, INEXTENSIBLE, DRAG>(…)` with the scene's three effect switches
@@ -67,6 +67,9 @@ pub struct DftlScratch<const N: usize> {
     /// ([`DftlScratch::begin`] zeroes them all) — made for each strand, its zeros and copies
     /// were 1.5 % of a DFTL step of 8 × 16 nodes on the Cortex-M4F.
     collider_push: ColliderPush<Real>,
+    /// A strand's positions at the start of its step, kept as its pass goes
+    /// ([`PassedPositions`]).
+    last_good: [Vec3; N],
     /// The projection workspace of a strand a grab holds.
     projection: ProjectionScratch<N>,
 }
@@ -82,6 +85,7 @@ impl<const N: usize> DftlScratch<N> {
         };
         DftlScratch {
             collider_push: [ZERO; MAX_COLLIDERS],
+            last_good: [Vec3::ZERO; N],
             projection: ProjectionScratch::new(),
         }
     }
@@ -117,35 +121,51 @@ pub fn step_strand<M: Math, const N: usize>(
     report: &mut StepReport,
 ) {
     let (grabs, index) = at;
-    let held = !grabbed_nodes(ctx, grabs, index, strand.rest.nodes.min(N)).is_empty();
+    // Most strands no grab names: a look at each grab's strand first.
+    let named = grabs
+        .iter()
+        .take(MAX_GRABS)
+        .any(|grab| grab.strand == index);
+    let held = named && !grabbed_nodes(ctx, grabs, index, strand.rest.nodes.min(N)).is_empty();
     let mut own = None;
-    let (push, projection) = match scratch {
-        Some(kept) => (&mut kept.collider_push, Some(&mut kept.projection)),
-        None => (own.insert([V3::zero(); MAX_COLLIDERS]), None),
+    let (push, last_good, projection) = match scratch {
+        Some(kept) => (
+            &mut kept.collider_push,
+            &mut kept.last_good,
+            Some(&mut kept.projection),
+        ),
+        None => {
+            let own = own.insert(([V3::zero(); MAX_COLLIDERS], [Vec3::ZERO; N]));
+            (&mut own.0, &mut own.1, None)
+        }
     };
     // The pushes of the scene's colliders in use, from zero.
     let push = &mut push[..ctx.colliders().len().min(MAX_COLLIDERS)];
     push.fill(V3::zero());
-    let step = (accelerations, push);
+    let step = (accelerations, push, last_good);
     if held {
         return step_held_strand::<M, N>(strand, setup, ctx, at, step, projection, report);
     }
     step_free_strand::<M, N>(strand, setup, ctx, at, step, report);
 }
 
+/// What a strand's pass takes besides the strand: the caller's accelerations, the pushes on
+/// the scene's colliders in use (zero) and where the positions are kept as the pass goes.
+type Passing<'a, const N: usize> = (Option<&'a [Vec3]>, &'a mut [V3<Real>], &'a mut [Vec3; N]);
+
 /// [`step_strand`] of a strand no grab holds this step, `push` the pushes of the scene's
-/// colliders in use, zero.
+/// colliders in use, zero, `last_good` where its positions are kept as the step goes.
 #[inline(always)]
 fn step_free_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     setup: &Setup,
     ctx: &StepContext,
     (_, index): (&[Grab], u32),
-    (accelerations, push): (Option<&[Vec3]>, &mut [V3<Real>]),
+    (accelerations, push, last_good): Passing<'_, N>,
     report: &mut StepReport,
 ) {
-    // Quarantine: the last good positions.
-    let last_good: Positions<N> = snapshot(strand, report);
+    // Quarantine: the last good positions, kept as the step goes.
+    snapshot_as_passed(strand, last_good, report);
     // Lines 12–15, fused into the pass below: external forces and the prediction.
     count_prediction(ctx, accelerations.is_some(), 1, report);
     // The root follows the head: nodes 0 and 1.
@@ -154,10 +174,12 @@ fn step_free_strand<M: Math, const N: usize>(
     // the velocities one node behind.
     count_constraints(setup, 1, report);
     let mut pass = 0.0;
-    let tally = strand_pass::<M, N>(setup, ctx, strand, (accelerations, push), &mut pass);
+    let passing = (accelerations, &mut *push, &mut *last_good);
+    let tally = strand_pass::<M, N>(setup, ctx, strand, passing, &mut pass);
     tally.report(report, push, setup.inv_dt);
     // Quarantine: every value written finite, or the last good positions back.
     let good = not_finite_sum(roots + pass) == 0.0;
+    let last_good = PassedPositions(last_good);
     let rolled_back = guard(strand, &last_good, |_, _| good, index, report);
     transmit_to_head(tally.head_force, rolled_back, report);
 }
@@ -179,11 +201,11 @@ fn step_held_strand<M: Math, const N: usize>(
     setup: &Setup,
     ctx: &StepContext,
     (grabs, index): (&[Grab], u32),
-    (accelerations, push): (Option<&[Vec3]>, &mut [V3<Real>]),
+    (accelerations, push, last_good): Passing<'_, N>,
     scratch: Option<&mut ProjectionScratch<N>>,
     report: &mut StepReport,
 ) {
-    let last_good: Positions<N> = snapshot(strand, report);
+    snapshot_as_passed(strand, last_good, report);
     count_prediction(ctx, accelerations.is_some(), 1, report);
     let roots = root_coupling(strand, ctx, report);
     // Lines 16–27 but line 19, which the projection takes, eq. 14's feedback of its
@@ -204,7 +226,8 @@ fn step_held_strand<M: Math, const N: usize>(
         report.ran(Stage::Shape);
     }
     let mut pass = 0.0;
-    let tally = strand_pass::<M, N>(&unprojected, ctx, strand, (accelerations, push), &mut pass);
+    let passing = (accelerations, &mut *push, &mut *last_good);
+    let tally = strand_pass::<M, N>(&unprojected, ctx, strand, passing, &mut pass);
     // The pass's push-outs act on the hair; its strain is the unprojected one: the
     // projection measures the segments and the contacts after it.
     Tally::report_pushes(report, push, setup.inv_dt);
@@ -216,6 +239,7 @@ fn step_held_strand<M: Math, const N: usize>(
         None => project_in_mode::<M, N>(strand, ctx, at, Mode::FixedCost, report),
     };
     let good = not_finite_sum(roots + pass) == 0.0 && strand.is_finite();
+    let last_good = PassedPositions(last_good);
     let rolled_back = guard(strand, &last_good, |_, _| good, index, report);
     if rolled_back {
         forces_after_roll_back(ctx, grabs, (strand, index), report);
@@ -273,15 +297,16 @@ fn count_constraints(setup: &Setup, strands: u32, report: &mut StepReport) {
 }
 
 /// The pass over one strand's free nodes with the effect switches fixed, its pushes on the
-/// scene's colliders in use added to `push` (zero before). Returns its tally for the report,
-/// and the [`component_sum`]s of the velocities it wrote, added, in `velocity_total`. (The
-/// tally alone is returned: returned in a pair, it was copied once more on the Cortex-M4F, 150
+/// scene's colliders in use added to `push` (zero before), the position each node had before
+/// the pass kept in `last_good` ([`PassedPositions`]). Returns its tally for the report, and
+/// the [`component_sum`]s of the velocities it wrote, added, in `velocity_total`. (The tally
+/// alone is returned: returned in a pair, it was copied once more on the Cortex-M4F, 150
 /// instructions a strand.)
 fn strand_pass<M: Math, const N: usize>(
     setup: &Setup,
     ctx: &StepContext,
     strand: &mut Strand<N>,
-    (accelerations, push): (Option<&[Vec3]>, &mut [V3<Real>]),
+    (accelerations, push, last_good): Passing<'_, N>,
     velocity_total: &mut Real,
 ) -> Tally {
     if strand.rest.nodes.min(N) < 3 {
@@ -291,7 +316,7 @@ fn strand_pass<M: Math, const N: usize>(
     let colliders = ctx.colliders();
     let (measures, total, momenta) = with_effect_switches!(
         setup,
-        nodes_of_strand::<M, N>(setup, strand, colliders, accelerations, push)
+        nodes_of_strand::<M, N>(setup, strand, colliders, accelerations, (push, last_good))
     );
     *velocity_total = total;
     Tally::from_measures::<M>(&measures, push, momenta, setup.inv_dt)
@@ -312,33 +337,28 @@ fn nodes_of_strand<
     strand: &mut Strand<N>,
     colliders: &[Shape],
     accelerations: Option<&[Vec3]>,
-    collider_push: &mut [V3<Real>],
+    kept: (&mut [V3<Real>], &mut [Vec3; N]),
 ) -> (Measures<Real>, Real, Momenta<Real>) {
     // Two copies of the node loop, without the caller's accelerations (the firmware's case)
     // and with them: in one loop for both, the compiler kept the test and a select in it, 28
     // more instructions a node on x86-64 (a fifth of a node's cost without shape).
     let fixed = setup.with_switches(SHAPE, INEXTENSIBLE, DRAG);
     match accelerations {
-        Some(a) => node_loop::<M, N>(
-            fixed,
-            strand,
-            colliders,
-            |i| a.get(i).copied(),
-            collider_push,
-        ),
-        None => node_loop::<M, N>(fixed, strand, colliders, |_| None, collider_push),
+        Some(a) => node_loop::<M, N>(fixed, strand, colliders, |i| a.get(i).copied(), kept),
+        None => node_loop::<M, N>(fixed, strand, colliders, |_| None, kept),
     }
 }
 
 /// The node loop of [`nodes_of_strand`], `extra(i)` being the caller's acceleration of node
-/// `i`, if any.
+/// `i`, if any; each node's pushes on the colliders added to `collider_push`, its position
+/// before the pass kept in `last_good`.
 #[inline(always)]
 fn node_loop<M: Math, const N: usize>(
     setup: Setup,
     strand: &mut Strand<N>,
     colliders: &[Shape],
     extra: impl Fn(usize) -> Option<Vec3>,
-    collider_push: &mut [V3<Real>],
+    (collider_push, last_good): (&mut [V3<Real>], &mut [Vec3; N]),
 ) -> (Measures<Real>, Real, Momenta<Real>) {
     let n = strand.rest.nodes.min(N);
     let rest = &strand.rest;
@@ -353,6 +373,7 @@ fn node_loop<M: Math, const N: usize>(
     let mut momenta = Momenta::zero();
     for i in 2..n {
         let node = NodeInput::of_strand(rest, state, i, extra(i));
+        last_good[i] = node.position.into();
         // Lines 13–21: predict, shape, follow the leader, collisions, frame.
         let (m, c) = (&mut measures, &mut *collider_push);
         let next = advance::<M, Real>(&setup, colliders, &node, &chain, previous_contact, m, c);
