@@ -352,6 +352,8 @@ fn nodes_of_strand<
 /// The node loop of [`nodes_of_strand`], `extra(i)` being the caller's acceleration of node
 /// `i`, if any; each node's pushes on the colliders added to `collider_push`, its position
 /// before the pass kept in `last_good`.
+// The loop reads and writes the state at nodes `i − 2`, `i − 1` and `i`: an index it is.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn node_loop<M: Math, const N: usize>(
     setup: Setup,

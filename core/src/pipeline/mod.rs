@@ -61,6 +61,9 @@ pub fn step_strands<M: Math, const N: usize>(
 /// that checks a world's raw bytes, `crate::world::WorldLayout::scratch`). A word, not a
 /// byte: with a byte and three of padding before the payload, a world built in place built
 /// its scratch space on the stack and copied it (3 KB at 16 nodes).
+// The variants differ by a kilobyte or two; one is kept at a time, in place (no heap to box
+// the larger one in, and boxing would defeat keeping it).
+#[allow(clippy::large_enum_variant)]
 #[repr(u32)]
 pub enum StepScratch<M: Math, const N: usize> {
     /// The rod's: its frames' buffer and its projection's lanes ([`RodScratch`]).
@@ -114,6 +117,12 @@ impl<M: Math, const N: usize> StepScratch<M, N> {
             StepScratch::Rod(_) => Solver::Rod,
             StepScratch::Dftl(_) => Solver::Dftl,
         }
+    }
+}
+
+impl<M: Math, const N: usize> Default for StepScratch<M, N> {
+    fn default() -> Self {
+        Self::new()
     }
 }
 
