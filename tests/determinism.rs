@@ -353,6 +353,89 @@ fn a_kept_block_scratch_carries_nothing_between_blocks_or_steps() {
     }
 }
 
+/// A `World` keeps DFTL's scratch space (`DftlScratch`: the collider pushes, the last good
+/// positions its pass keeps, the held strand's projection workspace) from strand to strand and
+/// step to step. Nothing may carry over: three DFTL strands of 24, 13 and 19 nodes with shape
+/// draped over the head's sphere, a shaking head, and a coupled grab that moves to the next strand
+/// every 100 steps, stepped through a kept scratch space (`step_strands_with`) and, from the
+/// same states and contexts, without one (`step_strands`, which makes what it needs on the
+/// stack), give the same state bits and the same report at every step of 600. Halfway, the
+/// scratch space is made the rod's and DFTL's again, as a world's `configure` does.
+#[test]
+fn a_kept_dftl_scratch_carries_nothing_between_strands_or_steps() {
+    use hairsim_core::collide::{Collider, Shape};
+    use hairsim_core::context::StepContext;
+    use hairsim_core::hash::state_hash;
+    use hairsim_core::pipeline::step_strands_with;
+    use hairsim_core::{
+        step_strands, Coupling, Effect, Effects, Grab, Material, Params, Pose, Real, Shake, Solver,
+        StepReport, StepScratch, Strand, Vec3,
+    };
+    const N: usize = 24;
+    let p = Params {
+        effects: Effects::from_slice(&[
+            Effect::Gravity,
+            Effect::Drag,
+            Effect::Inextensibility,
+            Effect::Shape,
+            Effect::Collisions,
+            Effect::Grabs,
+        ]),
+        ..Params::preset(Solver::Dftl)
+    };
+    let lengths = [24, 13, 19];
+    // Draped over the head: from near its top down a great circle, 0.2 mm outside the sphere.
+    let strand = |s: usize| {
+        let across = Vec3::new((2.0 * s as Real).cos(), 0.0, (2.0 * s as Real).sin());
+        let points: Vec<Vec3> = (0..lengths[s])
+            .map(|i| {
+                let a = 0.3 + i as Real * 0.12;
+                (across * a.sin() + Vec3::Y * a.cos()) * 0.0502
+            })
+            .collect();
+        Strand::<N>::from_polyline(&points, &Material::HUMAN_HAIR).unwrap()
+    };
+    let colliders = [Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius: 0.05,
+        },
+        attached_to_head: true,
+    }];
+    let mut kept: Vec<Strand<N>> = (0..3).map(strand).collect();
+    let mut made = kept.clone();
+    let mut scratch = StepScratch::<Libm, N>::for_solver(Solver::Dftl);
+    let mut previous = Pose::IDENTITY;
+    let mut contacts = 0;
+    for k in 0..600u32 {
+        let t = (k + 1) as Real * p.dt;
+        let head = Shake::TEN_RAD_PER_S.pose_at::<Libm>(t);
+        let ctx = StepContext::new(&p, previous, head, &colliders).at_time(t);
+        previous = head;
+        let held = (k / 100) % 3;
+        let node = lengths[held as usize] as u32 - 2;
+        let rest = made[held as usize].positions()[node as usize];
+        let circle = Vec3::new((t * 6.0).sin(), 0.0, (t * 6.0).cos()) * 0.01;
+        let grab =
+            Grab::new(held, node, rest + circle, 1000.0).with_coupling(Coupling::new(50.0, 0.05));
+        if k == 300 {
+            scratch.suit(Solver::Rod);
+            scratch.suit(Solver::Dftl);
+        }
+        let (mut with, mut without) = (StepReport::default(), StepReport::default());
+        let at = (0, core::slice::from_ref(&grab));
+        step_strands_with::<Libm, N>(&ctx, &mut kept, at, None, Some(&mut scratch), &mut with);
+        step_strands::<Libm, N>(&ctx, &mut made, 0, &[grab], None, &mut without);
+        assert_eq!(state_hash(&kept), state_hash(&made), "step {k}");
+        assert_eq!(format!("{with:?}"), format!("{without:?}"), "step {k}");
+        contacts += with.contacts;
+    }
+    assert!(
+        contacts > 0,
+        "no contact in 600 steps: the test would miss the contact rows"
+    );
+}
+
 /// A `World` keeps the rod step's scratch space (`RodScratch`: the frames' buffer and the
 /// projection's lanes) from strand to strand and step to step. Nothing may carry over: three
 /// strands of 24, 13 and 19 nodes in one world, where each strand's step finds the buffer as

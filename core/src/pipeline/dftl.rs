@@ -35,7 +35,6 @@ use crate::lane::{component_sum, not_finite_sum, Lane, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::params::{DftlCoefficients, Mode};
 use crate::projection::{project_in_mode, project_in_scratch, ProjectionScratch};
-
 use crate::report::{Stage, StepReport};
 use crate::root_coupling::root_coupling;
 use crate::snapshot::{snapshot, snapshot_as_passed, PassedPositions};
@@ -65,7 +64,7 @@ pub struct DftlScratch<const N: usize> {
     /// A strand's pushes on the scene's colliders (`Σ m Δx^push`): only the entries of the
     /// colliders in use are written, so only those are zeroed for each strand
     /// ([`DftlScratch::begin`] zeroes them all) — made for each strand, its zeros and copies
-    /// were 1.5 % of a DFTL step of 8 × 16 nodes on the Cortex-M4F.
+    /// were 1.4 % of a DFTL step of 8 × 16 nodes on the Cortex-M4F.
     collider_push: ColliderPush<Real>,
     /// A strand's positions at the start of its step, kept as its pass goes
     /// ([`PassedPositions`]).
