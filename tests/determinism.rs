@@ -281,6 +281,18 @@ mod rod_blocks {
 }
 
 /// The scratch tests' effects: bending, twist, inextensibility and collisions under gravity.
+/// The scratch tests' head: a sphere of 5 cm at the origin, attached to the head.
+fn head_sphere() -> hairsim_core::Collider {
+    use hairsim_core::{Shape, Vec3};
+    hairsim_core::Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius: 0.05,
+        },
+        attached_to_head: true,
+    }
+}
+
 fn scratch_test_params() -> hairsim_core::Params {
     use hairsim_core::{Effect, Effects, Params};
     Params {
@@ -302,7 +314,6 @@ fn scratch_test_params() -> hairsim_core::Params {
 /// inextensibility and the head's sphere on a shaking head.
 #[test]
 fn a_kept_block_scratch_carries_nothing_between_blocks_or_steps() {
-    use hairsim_core::collide::{Collider, Shape};
     use hairsim_core::context::StepContext;
     use hairsim_core::hash::state_hash;
     use hairsim_core::pipeline::step_strands_in_lanes_with;
@@ -323,13 +334,7 @@ fn a_kept_block_scratch_carries_nothing_between_blocks_or_steps() {
             .collect();
         Strand::<N>::from_polyline(&points, &Material::HUMAN_HAIR).unwrap()
     };
-    let colliders = [Collider {
-        shape: Shape::Sphere {
-            centre: Vec3::ZERO,
-            radius: 0.05,
-        },
-        attached_to_head: true,
-    }];
+    let colliders = [head_sphere()];
     let mut blocks: Vec<Strand<N>> = (0..lengths.len()).map(strand).collect();
     let mut alone = blocks.clone();
     let mut scratch: Box<RodBlockScratch<Libm, N, 2>> = Box::default();
@@ -363,7 +368,6 @@ fn a_kept_block_scratch_carries_nothing_between_blocks_or_steps() {
 /// scratch space is made the rod's and DFTL's again, as a world's `configure` does.
 #[test]
 fn a_kept_dftl_scratch_carries_nothing_between_strands_or_steps() {
-    use hairsim_core::collide::{Collider, Shape};
     use hairsim_core::context::StepContext;
     use hairsim_core::hash::state_hash;
     use hairsim_core::pipeline::step_strands_with;
@@ -395,13 +399,7 @@ fn a_kept_dftl_scratch_carries_nothing_between_strands_or_steps() {
             .collect();
         Strand::<N>::from_polyline(&points, &Material::HUMAN_HAIR).unwrap()
     };
-    let colliders = [Collider {
-        shape: Shape::Sphere {
-            centre: Vec3::ZERO,
-            radius: 0.05,
-        },
-        attached_to_head: true,
-    }];
+    let colliders = [head_sphere()];
     let mut kept: Vec<Strand<N>> = (0..3).map(strand).collect();
     let mut made = kept.clone();
     let mut scratch = StepScratch::<Libm, N>::for_solver(Solver::Dftl);
