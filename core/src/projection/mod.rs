@@ -636,11 +636,15 @@ fn smaller(a: Vec3, b: Vec3) -> Vec3 {
     Vec3::new(pick(a.x, b.x), pick(a.y, b.y), pick(a.z, b.z))
 }
 
-/// Per component, the larger of `a` and `b`, `a` where `b` is NaN ([`smaller`]'s mirror).
+/// Per component, the larger of `a` and `b`, `a` where `b` is NaN: [`Lane::max`], by a
+/// compare ([`smaller`]'s mirror).
 #[inline(always)]
 fn larger(a: Vec3, b: Vec3) -> Vec3 {
-    let pick = |a: Real, b: Real| if b > a { b } else { a };
-    Vec3::new(pick(a.x, b.x), pick(a.y, b.y), pick(a.z, b.z))
+    Vec3::new(
+        Lane::max(a.x, b.x),
+        Lane::max(a.y, b.y),
+        Lane::max(a.z, b.z),
+    )
 }
 
 impl NearColliders {
