@@ -4,7 +4,7 @@
 
 use hairsim_core::collide::{Collider, Shape};
 use hairsim_core::context::StepContext;
-use hairsim_core::projection::lanes::{project_strand, BlockProjection};
+use hairsim_core::projection::lanes::{project_strand, StrandProjection};
 use hairsim_core::{
     step_strands, Effect, Effects, Libm, Material, Mode, Params, Real, Shake, StepReport, Strand,
     Vec3,
@@ -98,7 +98,7 @@ pub fn predicted_states(count: usize) -> Vec<(u32, Vec<Strand<NODES>>)> {
 pub fn project_all(strands: &mut [Strand<NODES>], ctx: &StepContext) -> StepReport {
     let mut report = StepReport::default();
     // One scratch space for the call's strands, as `step_strands` makes.
-    let mut scratch = BlockProjection::default();
+    let mut scratch = StrandProjection::default();
     for (s, strand) in strands.iter_mut().enumerate() {
         project_strand::<Libm, NODES>(strand, ctx, (&[], s as u32), &mut scratch, &mut report);
     }

@@ -287,6 +287,16 @@ pub struct StrandState<const N: usize> {
     pub root_frame: Vec3,
 }
 
+impl<const N: usize> StrandState<N> {
+    /// All zero: a buffer before its first use.
+    pub const EMPTY: Self = StrandState {
+        position: [Vec3::ZERO; N],
+        velocity: [Vec3::ZERO; N],
+        theta: [0.0; N],
+        root_frame: Vec3::ZERO,
+    };
+}
+
 /// What the steps decided for a strand so far, which later steps follow: kept apart from the
 /// rest data (which never changes once built) and from the state (which a roll-back restores,
 /// and the state hash covers; `crate::hash` says why this is not hashed).

@@ -49,8 +49,9 @@ pub struct World<const S: usize, const N: usize, M: Math = DefaultMath> {
     /// A grab target given since the last step was not finite (and was ignored): the next
     /// step's report flags it.
     bad_target: bool,
-    /// The solver's scratch space: built here, made anew when `configure` changes the
-    /// solver, never per step (not state: not hashed, snapshotted or cloned).
+    /// The solver's scratch space: built by `configure` (or by the first step of a world
+    /// never configured), made anew when `configure` changes the solver, never per step (not
+    /// state: not hashed, snapshotted or cloned).
     scratch: StepScratch<M, N>,
     math: PhantomData<M>,
 }
@@ -86,7 +87,7 @@ pub struct WorldLayout {
     pub colliders: usize,
     /// The grabs, a [`Grabs`].
     pub grabs: usize,
-    /// The solver's scratch space, whose first word (a `u32`) is its variant, below 2
+    /// The solver's scratch space, whose first word (a `u32`) is its variant, below 3
     /// ([`StepScratch`](crate::pipeline::StepScratch)).
     pub scratch: usize,
 }
@@ -334,6 +335,7 @@ impl<const S: usize, const N: usize, M: Math> World<S, N, M> {
         };
         let ctx = begin(world, &inputs, report);
         let accelerations = input.accelerations;
+        self.scratch.suit(self.params.solver);
         let scratch = Some(&mut self.scratch);
         let at = (0, &self.grabs[..]);
         step_strands_with::<M, N>(&ctx, &mut self.strands, at, accelerations, scratch, report);

@@ -60,12 +60,12 @@
  * 10 rad/s; the slowest step of 200 in fixed-cost mode, and the deepest stack.
  *
  *   strands x nodes  world RAM  stack  rod us  DFTL us
- *     1 x 16            8704  10072     879      228
- *     4 x 16           14640  10072   2,598      394
- *     8 x 16           22560  10072   4,869      616
- *     4 x 32           27808  16112   5,174      755
- *     8 x 24           32984  12872   7,138      904
- *    16 x 32           74608  16112  18,791    2,087
+ *     1 x 16           14824   3564     810      223
+ *     4 x 16           20760   3564   2,496      388
+ *     8 x 16           28680   3564   4,725      608
+ *     4 x 32           39224   4188   4,877      748
+ *     8 x 24           41752   3804   6,903      898
+ *    16 x 32           86024   4196  17,897    2,078
  */
 
 #ifndef HAIRSIM_H
@@ -90,7 +90,7 @@
  * no fewer than a 32-bit target needs (hairsim_get_capacity gives the running target's own).
  */
 #define HAIRSIM_WORLD_SIZE_FOR(strands, nodes) \
-  ((size_t)1299u + (size_t)343u * (size_t)(nodes) + \
+  ((size_t)2166u + (size_t)674u * (size_t)(nodes) + \
    (size_t)(strands) * ((size_t)76u + (size_t)120u * (size_t)(nodes)))
 /** Bytes of a world buffer at HAIRSIM_STRANDS and HAIRSIM_NODES. */
 #define HAIRSIM_WORLD_SIZE HAIRSIM_WORLD_SIZE_FOR(HAIRSIM_STRANDS, HAIRSIM_NODES)

@@ -425,30 +425,30 @@ fn grab_forces(report: &StepReport) -> &[Vec3; HAIRSIM_MAX_GRABS] {
     &report.grab_forces
 }
 
-pub(crate) fn report_to_c(r: &StepReport) -> hairsim_step_report {
-    let mut out = hairsim_step_report {
-        flags: FLAGS
-            .iter()
-            .filter(|(_, flag)| r.flags.contains(*flag))
-            .fold(0, |bits, (bit, _)| bits | bit),
-        iterations_max: r.iterations_max,
-        iterations_total: r.iterations_total,
-        cap_hits: r.cap_hits,
-        dropped_rows: r.dropped_rows,
-        contacts: r.contacts,
-        rolled_back: r.rolled_back,
-        rolled_back_strand_count: 0,
-        rolled_back_strands: [0; HAIRSIM_NAMED_STRANDS],
-        grabs_slipped: u32::from(r.grabs_slipped),
-        residual: r.residual,
-        max_stretch: r.max_stretch,
-        max_contact_stretch: r.max_contact_stretch,
-        max_penetration: r.max_penetration,
-        grab_forces: [hairsim_vec3::default(); HAIRSIM_MAX_GRABS],
-        head_force: vec3_to_c(r.head_force),
-        collider_forces: [hairsim_vec3::default(); HAIRSIM_MAX_COLLIDERS],
-        stage_runs: r.stage_runs,
-    };
+/// `r` in its C form, written over `out` field by field (built and returned, it was a copy on
+/// the stack of every step).
+pub(crate) fn report_into_c(r: &StepReport, out: &mut hairsim_step_report) {
+    out.flags = FLAGS
+        .iter()
+        .filter(|(_, flag)| r.flags.contains(*flag))
+        .fold(0, |bits, (bit, _)| bits | bit);
+    out.iterations_max = r.iterations_max;
+    out.iterations_total = r.iterations_total;
+    out.cap_hits = r.cap_hits;
+    out.dropped_rows = r.dropped_rows;
+    out.contacts = r.contacts;
+    out.rolled_back = r.rolled_back;
+    out.rolled_back_strand_count = 0;
+    out.rolled_back_strands = [0; HAIRSIM_NAMED_STRANDS];
+    out.grabs_slipped = u32::from(r.grabs_slipped);
+    out.residual = r.residual;
+    out.max_stretch = r.max_stretch;
+    out.max_contact_stretch = r.max_contact_stretch;
+    out.max_penetration = r.max_penetration;
+    out.grab_forces = [hairsim_vec3::default(); HAIRSIM_MAX_GRABS];
+    out.head_force = vec3_to_c(r.head_force);
+    out.collider_forces = [hairsim_vec3::default(); HAIRSIM_MAX_COLLIDERS];
+    out.stage_runs = r.stage_runs;
     for (slot, &s) in out
         .rolled_back_strands
         .iter_mut()
@@ -463,5 +463,4 @@ pub(crate) fn report_to_c(r: &StepReport) -> hairsim_step_report {
     for (slot, &f) in out.collider_forces.iter_mut().zip(&r.collider_forces) {
         *slot = vec3_to_c(f);
     }
-    out
 }

@@ -110,7 +110,7 @@ pub(crate) unsafe fn structure(cell: *const Cell) -> Result<(), Refused> {
     // SAFETY: the scratch space's variant is a `u32` at its offset inside the world, aligned
     // (the enum is `repr(u32)`); any bytes are a `u32`.
     let scratch = unsafe { base.add(layout.scratch).cast::<u32>().read() };
-    expect(scratch < 2, Name::Scratch, None)?;
+    expect(scratch < 3, Name::Scratch, None)?;
     // SAFETY: the lists lie at the layout's offsets inside the world, and a `heapless::Vec`'s
     // every byte pattern is a value (its storage is `MaybeUninit`): a reference to one is
     // sound whatever its bytes. Only its capacity and its buffer's address are asked of it;

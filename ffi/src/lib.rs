@@ -48,7 +48,9 @@ use core::mem::{align_of, size_of};
 use core::ptr::{self, addr_of, addr_of_mut};
 use core::sync::atomic::{AtomicU32, Ordering};
 
-use hairsim_core::{Coupling, DefaultMath, Grab, Material, Math, Params, StepInput, Vec3, World};
+use hairsim_core::{
+    Coupling, DefaultMath, Grab, Material, Math, Params, StepInput, StepReport, Vec3, World,
+};
 
 use convert::Result;
 use integrity::Checksums;
@@ -207,6 +209,28 @@ unsafe fn write_optional<T>(p: *mut T, value: T, argument: Name) -> Result<()> {
     }
     // SAFETY: the caller's promise for a non-NULL `p`.
     unsafe { write(p, value, argument) }
+}
+
+/// Writes the C form of the step report `r` to `p` if `p` is not NULL (the argument
+/// `report`), in place.
+///
+/// # Safety
+/// `p`, if not NULL, must be valid for writes of a `hairsim_step_report` that nothing else
+/// reads or writes meanwhile.
+unsafe fn write_report(p: *mut hairsim_step_report, r: &StepReport) -> Result<()> {
+    if p.is_null() {
+        return Ok(());
+    }
+    check_ptr(p, Name::Report)?;
+    // SAFETY: `p` is non-NULL and aligned (checked) and valid for writes of a report (the
+    // caller's promise). Zeroed first, its bytes are a valid report (integers and floats
+    // only), so the reference below is to a valid value, and nothing else reaches it.
+    let out = unsafe {
+        ptr::write_bytes(p, 0, 1);
+        &mut *p
+    };
+    convert::report_into_c(r, out);
+    Ok(())
 }
 
 /// The caller's array `(p, count)` (the argument `argument`) as a slice, after checking the
@@ -824,6 +848,9 @@ pub unsafe extern "C" fn hairsim_step(
         // SAFETY: the caller's promise for `world`.
         Err(why) => return unsafe { refuse(world, F, why) },
     };
+    // The report is written here and converted into the caller's: not moved out of the
+    // closure (each move of it was a copy on the stack, the frame of every step).
+    let mut r = StepReport::default();
     let step = |w: &mut SimWorld| {
         if checked.target_count > w.grabs().len() {
             let more = Refused::from(hairsim_error::OutOfRange).field(Name::GrabTargetCount);
@@ -833,16 +860,18 @@ pub unsafe extern "C" fn hairsim_step(
             w.set_grab_target(g, t);
         }
         let accelerations = checked.accelerations;
-        Ok(w.step(&StepInput {
+        let input = StepInput {
             head: checked.head,
             accelerations: (!accelerations.is_empty()).then_some(accelerations),
-        }))
+        };
+        w.step_into(&input, &mut r);
+        Ok(())
     };
     // SAFETY: the caller's promise for `world`.
     match unsafe { with_world(world, F, step) } {
         // SAFETY: the caller's promise for `report` (checked; the world is no
         // longer borrowed).
-        Ok(r) => code(unsafe { write_optional(report, convert::report_to_c(&r), Name::Report) }),
+        Ok(()) => code(unsafe { write_report(report, &r) }),
         Err(e) => e.code,
     }
 }

@@ -9,7 +9,7 @@
 
 use arbitrary::Arbitrary;
 use hairsim_core::context::StepContext;
-use hairsim_core::projection::lanes::{project_strand, BlockProjection};
+use hairsim_core::projection::lanes::{project_strand, StrandProjection};
 use hairsim_core::{
     Collider, Effect, Effects, Grab, Libm, Material, Mode, Params, Pose, Shape, StepReport, Strand,
     Vec3,
@@ -138,7 +138,7 @@ fuzz_target!(|input: Input| {
         .collect();
     let ctx = StepContext::new(&params, Pose::IDENTITY, Pose::IDENTITY, &colliders);
     let mut report = StepReport::default();
-    let mut scratch = BlockProjection::new();
+    let mut scratch = StrandProjection::new();
     let at = (&grabs[..], 0);
     let outcome = project_strand::<Libm, N>(&mut strand, &ctx, at, &mut scratch, &mut report);
     assert!(strand.is_finite(), "finite in, non-finite out");

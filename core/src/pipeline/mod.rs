@@ -57,38 +57,35 @@ pub fn step_strands<M: Math, const N: usize>(
 /// own, one solver's at a time. Not state: never hashed, snapshotted or cloned (a clone is a
 /// new one), and every value a step reads of it, the step has written.
 ///
-/// `repr(u32)`: its first word is the variant, 0 for the rod's and 1 for DFTL's (for a caller
-/// that checks a world's raw bytes, `crate::world::WorldLayout::scratch`). A word, not a
-/// byte: with a byte and three of padding before the payload, a world built in place built
-/// its scratch space on the stack and copied it (3 KB at 16 nodes).
-// The variants differ by a kilobyte or two; one is kept at a time, in place (no heap to box
-// the larger one in, and boxing would defeat keeping it).
+/// `repr(u32)`: its first word is the variant, 0 for the rod's, 1 for DFTL's and 2 before a
+/// solver is chosen (for a caller that checks a world's raw bytes,
+/// `crate::world::WorldLayout::scratch`). A word, not a byte: with a byte and three of
+/// padding before the payload, a world built in place built its scratch space on the stack
+/// and copied it (3 KB at 16 nodes).
+///
+/// A world is built with [`StepScratch::Unsuited`], one word to write, and [`Self::suit`]
+/// builds the solver's where the solver is set (`World::configure`) and, for a world stepped
+/// unconfigured, in its first step. Built with the world, the rod's passed through the
+/// optimiser's temporaries on the stack of `hairsim_init` (2.5 KB at 16 nodes, 7.3 KB at 32).
+// The variants differ by kilobytes; one is kept at a time, in place (no heap to box the
+// larger one in, and boxing would defeat keeping it).
 #[allow(clippy::large_enum_variant)]
 #[repr(u32)]
 pub enum StepScratch<M: Math, const N: usize> {
-    /// The rod's: its frames' buffer and its projection's lanes ([`RodScratch`]).
+    /// The rod's: its frames' buffer and its projections' workspaces ([`RodScratch`]).
     Rod(RodScratch<M, N>) = 0,
     /// DFTL's: a strand's pushes on the colliders and the projection workspace of a strand
     /// that a grab holds ([`dftl::DftlScratch`]).
     Dftl(DftlScratch<N>) = 1,
+    /// Not built yet: what a world starts with.
+    Unsuited = 2,
 }
 
 impl<M: Math, const N: usize> StepScratch<M, N> {
-    /// The scratch space of [`Params::DEFAULT`]'s solver, before its first use (one variant
-    /// named, not chosen by a `match`: so that a world built in place builds it in place).
-    #[cfg(feature = "rod")]
-    #[inline(always)]
+    /// Before a solver is chosen: [`Self::suit`] builds the solver's.
     #[must_use]
     pub const fn new() -> Self {
-        StepScratch::Rod(RodScratch::new())
-    }
-
-    /// The scratch space of [`Params::DEFAULT`]'s solver, DFTL in a build without the rod.
-    #[cfg(not(feature = "rod"))]
-    #[inline(always)]
-    #[must_use]
-    pub const fn new() -> Self {
-        StepScratch::Dftl(DftlScratch::new())
+        StepScratch::Unsuited
     }
 
     /// The scratch space of `solver`, before its first use.
@@ -99,23 +96,51 @@ impl<M: Math, const N: usize> StepScratch<M, N> {
         scratch
     }
 
-    /// Made anew for `solver` if it is another solver's. Where the solver is set (a world's
-    /// `configure`), not in a step; each variant is written where it lives (chosen by a
-    /// `match` and then written, it passed through the stack: 6 KB at 16 nodes).
+    /// Made anew for `solver` unless it is `solver`'s already: where the solver is set (a
+    /// world's `configure`) and before each step (a compare, once it is built).
+    #[inline(always)]
     pub fn suit(&mut self, solver: Solver) {
-        match (solver, &*self) {
-            (Solver::Rod, StepScratch::Dftl(_)) => *self = StepScratch::Rod(RodScratch::new()),
-            (Solver::Dftl, StepScratch::Rod(_)) => *self = StepScratch::Dftl(DftlScratch::new()),
-            _ => {}
+        if self.solver() != Some(solver) {
+            self.build(solver);
         }
     }
 
-    /// The solver whose scratch space this is.
+    /// `solver`'s, written where it lives. Out of line and cold: rare, and off the frame of a
+    /// step. A solver this build leaves out gets none (`Params::validate` refused it).
+    #[cold]
+    #[inline(never)]
+    fn build(&mut self, solver: Solver) {
+        match solver {
+            Solver::Rod if cfg!(feature = "rod") => self.build_rod(),
+            Solver::Dftl if cfg!(feature = "dftl") => self.build_dftl(),
+            Solver::Rod | Solver::Dftl => {}
+        }
+    }
+
+    /// The rod's, copied from a constant (from flash on the Cortex-M4F): built by code, the
+    /// optimiser assembled parts of it, or all of it, on the stack first (19 KB at 16 nodes in
+    /// one variant). Apart from DFTL's: one function for both held the temporaries of both.
+    #[inline(never)]
+    fn build_rod(&mut self) {
+        *self = Self::EMPTY_ROD;
+    }
+
+    /// The rod's, before its first use.
+    const EMPTY_ROD: Self = StepScratch::Rod(RodScratch::new());
+
+    /// DFTL's, built in place.
+    #[inline(never)]
+    fn build_dftl(&mut self) {
+        *self = StepScratch::Dftl(DftlScratch::new());
+    }
+
+    /// The solver whose scratch space this is, if it has been built.
     #[must_use]
-    pub fn solver(&self) -> Solver {
+    pub fn solver(&self) -> Option<Solver> {
         match self {
-            StepScratch::Rod(_) => Solver::Rod,
-            StepScratch::Dftl(_) => Solver::Dftl,
+            StepScratch::Rod(_) => Some(Solver::Rod),
+            StepScratch::Dftl(_) => Some(Solver::Dftl),
+            StepScratch::Unsuited => None,
         }
     }
 }
@@ -128,7 +153,7 @@ impl<M: Math, const N: usize> Default for StepScratch<M, N> {
 
 impl<M: Math, const N: usize> Clone for StepScratch<M, N> {
     fn clone(&self) -> Self {
-        Self::for_solver(self.solver())
+        self.solver().map_or_else(Self::new, Self::for_solver)
     }
 }
 
@@ -149,7 +174,6 @@ pub fn step_strands_with<M: Math, const N: usize>(
     scratch: Option<&mut StepScratch<M, N>>,
     report: &mut StepReport,
 ) {
-    let of_strand = |k: usize| accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
     // A solver this build leaves out (`Solver::is_built`) steps nothing: `Params::validate`
     // refused it, and its code is not linked.
     match ctx.params.solver {
@@ -174,24 +198,41 @@ pub fn step_strands_with<M: Math, const N: usize>(
             ),
         },
         Solver::Dftl if cfg!(feature = "dftl") => {
-            // What a DFTL step derives from the context (the head's rotation matrix among it)
-            // is the same for every strand: once per block.
-            let setup = Setup::new(ctx);
-            let mut kept = match scratch {
+            let kept = match scratch {
                 Some(StepScratch::Dftl(kept)) => Some(kept),
                 _ => None,
             };
-            if let Some(kept) = kept.as_deref_mut() {
-                kept.begin();
-            }
-            for (k, strand) in strands.iter_mut().enumerate() {
-                let index = first_strand + k as u32;
-                let at = (grabs, index);
-                let work = kept.as_deref_mut();
-                dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand(k), work, report);
-            }
+            let at = (first_strand, grabs);
+            step_dftl_strands::<M, N>(ctx, strands, at, accelerations, kept, report);
         }
         Solver::Rod | Solver::Dftl => {}
+    }
+}
+
+/// DFTL's strands of [`step_strands_with`] in the scratch space `kept`, if any. Out of line:
+/// inlined, its locals (the set-up, the colliders placed for the step) sat in the frame
+/// under every rod step too (0.8 KB of the C ABI's `hairsim_step` on the Cortex-M4F).
+#[inline(never)]
+fn step_dftl_strands<M: Math, const N: usize>(
+    ctx: &StepContext,
+    strands: &mut [Strand<N>],
+    (first_strand, grabs): (u32, &[Grab]),
+    accelerations: Option<&[Vec3]>,
+    mut kept: Option<&mut DftlScratch<N>>,
+    report: &mut StepReport,
+) {
+    // What a DFTL step derives from the context (the head's rotation matrix among it) is the
+    // same for every strand: once per block.
+    let setup = Setup::new(ctx);
+    if let Some(kept) = kept.as_deref_mut() {
+        kept.begin();
+    }
+    for (k, strand) in strands.iter_mut().enumerate() {
+        let index = first_strand + k as u32;
+        let at = (grabs, index);
+        let work = kept.as_deref_mut();
+        let of_strand = accelerations.and_then(|a| a.get(k * N..(k + 1) * N));
+        dftl::step_strand::<M, N>(strand, &setup, ctx, at, of_strand, work, report);
     }
 }
 

@@ -23,19 +23,21 @@ use crate::grab::{forces_after_roll_back, grabbed_nodes, Grab};
 use crate::guard::{guard, sound};
 use crate::lane::Natural;
 use crate::math::{unit, Math, Real, Vec3};
-use crate::projection::lanes::{project_strand, BlockProjection};
-use crate::projection::project_constraints;
+use crate::projection::lanes::{project_strand, BlockProjection, StrandSpace};
+use crate::projection::{project_in_scratch, Outcome, ProjectionScratch};
 use crate::report::{Stage, StepReport};
 use crate::rod::energy::elastic_forces_with_angles;
 use crate::rod::frames::{material_angles, RodFrames};
+use crate::rod::implicit::BendingSystem;
 use crate::rod::integrate::{symplectic_euler, Motion, Nodes};
 use crate::rod::substeps::{
-    inextensibility_between_substeps, plan, smallest_binormal_denominator, Integration,
+    inextensibility_between_substeps, plan, projects_between_substeps,
+    smallest_binormal_denominator, Integration,
 };
 use crate::rod::twist::ClampedFrames;
 use crate::rod::{implicit, twist, ClampedSegments, ElasticTerms};
 use crate::root_coupling::{carry_root_frame, elastic_on_root, held_velocity, root_coupling};
-use crate::snapshot::snapshot;
+use crate::snapshot::snapshot_into;
 use crate::strand::{Strand, StrandState};
 
 /// Steps one strand by `ctx.dt` (Kmoch Algorithm 1, lines 3–11). `index` is the strand's
@@ -63,9 +65,9 @@ pub fn step_strand<M: Math, const N: usize>(
     let begun = begin(
         strand,
         ctx,
-        grabs,
-        index,
+        (grabs, index),
         starting_from(frames.as_deref()),
+        &mut scratch.last_good,
         report,
     );
     // Lines 3–4: forces and integration, in substeps or one linearly implicit step.
@@ -73,34 +75,105 @@ pub fn step_strand<M: Math, const N: usize>(
         strand,
         ctx,
         &begun,
-        frames.as_deref_mut(),
+        (
+            frames.as_deref_mut(),
+            &mut scratch.projection.solves,
+            &mut scratch.integration,
+        ),
         accelerations,
         report,
     );
     // Lines 5–11.
     let at = (grabs, index, &mut scratch.projection);
-    finish(strand, ctx, at, (&begun, on_root), frames, &angles, report);
+    let started = (&begun, &scratch.last_good, on_root);
+    finish(strand, ctx, at, started, frames, &angles, report);
 }
 
-/// Scratch space for [`step_strand`]: the frames' buffer and the projection's lanes at one
-/// lane. A [`crate::World`] keeps one, built at compile time; `step_strands` makes one for
-/// all the strands of a call. Nothing in it carries from one strand or step to the next (each
+/// Scratch space for [`step_strand`]: the strand's last good state, the frames' buffer, the
+/// substeps' forces and motion ([`IntegrationSpace`]), and the projections' and the implicit
+/// step's workspaces ([`RodProjection`]). A
+/// [`crate::World`] keeps one, inside `hairsim_init`'s buffer; `step_strands` makes one for all
+/// the strands of a call. Nothing in it carries from one strand or step to the next (each
 /// strand's step sets what it reads): made for each strand, its zeros and copies were 5 % of
-/// the Cortex-M4F's rod step (`firmware/profile.py`).
+/// the Cortex-M4F's rod step (`firmware/profile.py`), and on the stack its kilobytes were
+/// most of a step's stack (10 KB at 16 nodes).
 pub struct RodScratch<M: Math, const N: usize> {
+    pub(super) last_good: StrandState<N>,
     pub(super) frames: RodFrames<M, N>,
-    pub(super) projection: BlockProjection<N, 1, Natural>,
+    pub(super) integration: IntegrationSpace<N>,
+    pub(super) projection: RodProjection<M, N>,
+}
+
+/// What lines 3–4 of a strand's step work on: the elastic forces, and the substeps' motion
+/// ([`Motion`]). Every value a step reads of it, the step has written.
+pub(super) struct IntegrationSpace<const N: usize> {
+    forces: [Vec3; N],
+    motion: Motion<N>,
+}
+
+impl<const N: usize> IntegrationSpace<N> {
+    /// Before its first use.
+    const EMPTY: Self = IntegrationSpace {
+        forces: [Vec3::ZERO; N],
+        motion: Motion {
+            start: [Vec3::ZERO; N],
+            displacement: [Vec3::ZERO; N],
+        },
+    };
 }
 
 impl<M: Math, const N: usize> RodScratch<M, N> {
-    /// Before its first use.
+    /// Before its first use (always inlined, so that a world built in place builds it in
+    /// place).
+    #[inline(always)]
     #[must_use]
     pub const fn new() -> Self {
         RodScratch {
+            last_good: StrandState::EMPTY,
             frames: RodFrames::empty(),
-            projection: BlockProjection::new(),
+            integration: IntegrationSpace::EMPTY,
+            projection: RodProjection {
+                lanes: BlockProjection::new(),
+                solves: Solves::EMPTY,
+            },
         }
     }
+}
+
+/// Where a rod strand is projected ([`StrandSpace`]): the lanes' space at one lane, and the
+/// general projection's workspace, beside the implicit step's ([`Solves`]).
+pub(super) struct RodProjection<M: Math, const N: usize> {
+    pub(super) lanes: BlockProjection<N, 1, Natural>,
+    pub(super) solves: Solves<M, N>,
+}
+
+impl<M: Math, const N: usize> StrandSpace<N> for RodProjection<M, N> {
+    #[inline(always)]
+    fn lanes(&mut self) -> &mut BlockProjection<N, 1, Natural> {
+        &mut self.lanes
+    }
+
+    #[inline(always)]
+    fn general(&mut self, project: impl FnOnce(&mut ProjectionScratch<N>) -> Outcome) -> Outcome {
+        project(&mut self.solves.projection)
+    }
+}
+
+/// The two solves' workspaces of a strand's step: the general projection's
+/// (`projection::project_in_scratch`: a grabbed strand's, and those between substeps) and the
+/// implicit step's system (`rod::implicit::BendingSystem`), reached through one pointer (as
+/// two, the implicit step took 5 k more instructions on the Cortex-M4F).
+pub(super) struct Solves<M: Math, const N: usize> {
+    pub(super) projection: ProjectionScratch<N>,
+    pub(super) system: BendingSystem<M, N>,
+}
+
+impl<M: Math, const N: usize> Solves<M, N> {
+    /// Before their first use.
+    const EMPTY: Self = Solves {
+        projection: ProjectionScratch::new(),
+        system: BendingSystem::EMPTY,
+    };
 }
 
 impl<M: Math, const N: usize> Default for RodScratch<M, N> {
@@ -124,8 +197,6 @@ impl<M: Math, const N: usize> core::fmt::Debug for RodScratch<M, N> {
 
 /// What a strand's step decided and kept before its forces and integration.
 pub(super) struct Begun<M: Math, const N: usize> {
-    /// Quarantine: the last good state.
-    last_good: StrandState<N>,
     /// Sec. 7.2: the clamped segments C, the root's and each grabbed node's.
     pub(super) clamped: ClampedSegments,
     /// What the step keeps of the configuration it starts from.
@@ -167,22 +238,22 @@ pub(super) fn starting_from<M: Math, const N: usize>(
     }
 }
 
-/// The start of a strand's step: the snapshot, the clamped set, what the step keeps of its
-/// starting configuration and its integration's plan, from what `starting` says of the
-/// strand's frames.
+/// The start of a strand's step: the snapshot (into `last_good`), the clamped set, what the
+/// step keeps of its starting configuration and its integration's plan, from what `starting`
+/// says of the strand's frames.
 pub(super) fn begin<M: Math, const N: usize, F, C>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    grabs: &[Grab],
-    index: u32,
+    (grabs, index): (&[Grab], u32),
     starting: Starting<F, C>,
+    last_good: &mut StrandState<N>,
     report: &mut StepReport,
 ) -> Begun<M, N>
 where
     F: FnOnce(&Strand<N>) -> Real,
     C: FnOnce(&Strand<N>, &ClampedSegments) -> Option<ClampedFrames<M>>,
 {
-    let last_good: StrandState<N> = snapshot(strand, report);
+    snapshot_into(strand, last_good, report);
     let clamped = ClampedSegments::of_step(&ctx.gates, grabs, index, strand.rest.nodes);
     let x = &strand.state.position;
     let start = StepStart {
@@ -198,7 +269,6 @@ where
     let integration = plan(ctx, &strand.rest.rod, (&mut schedule, held), smallest);
     strand.schedule = schedule;
     Begun {
-        last_good,
         clamped,
         start,
         integration,
@@ -206,27 +276,39 @@ where
 }
 
 /// Lines 3–4 on one strand: its explicit substeps or its implicit step. `frames` are those of
-/// the centreline the step starts from. Returns the angles the forces used and the mean
+/// the centreline the step starts from; `solves` the workspaces of the projections between
+/// substeps and of the implicit step. Returns the angles the forces used and the mean
 /// elastic force on the held nodes 0 and 1 over the step ([`Integrated`]).
 pub(super) fn integrate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     begun: &Begun<M, N>,
-    frames: Option<&mut RodFrames<M, N>>,
+    (frames, solves, space): Workspaces<'_, M, N>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> Integrated<N> {
     let clamped = &begun.clamped;
     match (begun.integration, frames) {
         (Integration::Implicit, Some(frames)) => {
-            implicit_bending(strand, ctx, clamped, frames, accelerations, report)
+            let space = (&*frames, solves, &mut space.forces);
+            implicit_bending(strand, ctx, clamped, space, accelerations, report)
         }
         (integration, frames) => {
             let k = integration.substeps();
-            explicit_substeps(strand, ctx, clamped, frames, k, accelerations, report)
+            let space = (frames, solves, space);
+            explicit_substeps(strand, ctx, clamped, space, k, accelerations, report)
         }
     }
 }
+
+/// The space lines 3–4 work in: the frames (with bending or twist on), the projection's
+/// workspace (between substeps) and the implicit step's system ([`Solves`]), and the forces
+/// and the motion ([`IntegrationSpace`]).
+pub(super) type Workspaces<'a, M, const N: usize> = (
+    Option<&'a mut RodFrames<M, N>>,
+    &'a mut Solves<M, N>,
+    &'a mut IntegrationSpace<N>,
+);
 
 /// What lines 3–4 hand on: the `(cos θ^j, sin θ^j)` the forces used, and the mean elastic
 /// force on the held nodes 0 and 1 over the step (`root_coupling::elastic_on_root`).
@@ -240,15 +322,15 @@ pub(super) type Integrated<const N: usize> = ([[Real; 2]; N], Vec3);
 pub(super) fn finish<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1, Natural>),
-    (begun, on_root): (&Begun<M, N>, Vec3),
+    (grabs, index, projection): (&[Grab], u32, &mut RodProjection<M, N>),
+    (begun, last_good, on_root): (&Begun<M, N>, &StrandState<N>, Vec3),
     frames: Option<&mut RodFrames<M, N>>,
     angles: &[[Real; 2]; N],
     report: &mut StepReport,
 ) {
     let pull = constrain(strand, ctx, (grabs, index, projection), begun, report);
     twist_alone(strand, ctx, begun, frames, angles, report);
-    let rolled_back = judge(strand, ctx, index, begun, report);
+    let rolled_back = judge(strand, ctx, index, last_good, report);
     transmit(
         strand,
         ctx,
@@ -282,7 +364,7 @@ pub(super) fn transmit<const N: usize>(
 pub(super) fn constrain<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    (grabs, index, projection): (&[Grab], u32, &mut BlockProjection<N, 1, Natural>),
+    (grabs, index, projection): (&[Grab], u32, &mut RodProjection<M, N>),
     begun: &Begun<M, N>,
     report: &mut StepReport,
 ) -> Vec3 {
@@ -337,18 +419,19 @@ pub(super) fn twist_alone<M: Math, const N: usize>(
     }
 }
 
-/// Line 11: the guard. A strand the explicit substeps lost takes the implicit step from now.
-/// Returns whether the strand was rolled back.
+/// Line 11: the guard, back to `last_good` if the step went wrong. A strand the explicit
+/// substeps lost takes the implicit step from now. Returns whether the strand was rolled
+/// back.
 #[inline(always)]
-pub(super) fn judge<M: Math, const N: usize>(
+pub(super) fn judge<const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     index: u32,
-    begun: &Begun<M, N>,
+    last_good: &StrandState<N>,
     report: &mut StepReport,
 ) -> bool {
     let verdict = |s: &Strand<N>, _| sound(s, ctx.gates.inextensibility);
-    let rolled_back = guard(strand, &begun.last_good, verdict, index, report);
+    let rolled_back = guard(strand, last_good, verdict, index, report);
     if rolled_back {
         strand.schedule.implicit_bending = true;
     }
@@ -363,19 +446,21 @@ pub(super) fn judge<M: Math, const N: usize>(
 /// recomputed in place for each later substep. Returns `(cos θ^j, sin θ^j)` of the angles
 /// the forces used (the hair-optimised twist compares against them) and the mean force on the
 /// held nodes 0 and 1 over the step: the elastic forces on them and, between substeps, the
-/// projections' pull on node 1.
+/// projections' pull on node 1 (they run in `solves`).
 fn explicit_substeps<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     clamped: &ClampedSegments,
-    mut frames: Option<&mut RodFrames<M, N>>,
+    (mut frames, solves, space): Workspaces<'_, M, N>,
     k: u32,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> Integrated<N> {
     let h = ctx.dt / k as Real;
     let terms = ElasticTerms::of(&ctx.gates);
-    let mut forces = [Vec3::ZERO; N];
+    let IntegrationSpace { forces, motion } = space;
+    // Zero without bending or twist, and where the elastic forces write none.
+    *forces = [Vec3::ZERO; N];
     let segments = strand.rest.nodes.saturating_sub(1).min(N);
     // θ is held over the substeps: its sines and cosines are computed once.
     let cos_sin = if frames.is_some() {
@@ -387,8 +472,8 @@ fn explicit_substeps<M: Math, const N: usize>(
     report.ran(Stage::ExternalForces);
     report.ran(Stage::Integrate);
     let external = External::<M>::of(ctx);
-    let mut motion = Motion::from(strand);
-    let between = inextensibility_between_substeps(ctx, k, h);
+    motion.restart(strand);
+    let between = projects_between_substeps(ctx, k);
     let mut on_root = Vec3::ZERO;
     for substep in 0..k {
         if let Some(frames) = frames.as_deref_mut() {
@@ -397,8 +482,8 @@ fn explicit_substeps<M: Math, const N: usize>(
                 frames.refresh(strand);
             }
             let (theta, rest) = (&strand.state.theta, &strand.rest.rod);
-            elastic_forces_with_angles(frames, theta, &cos_sin, rest, clamped, terms, &mut forces);
-            on_root += elastic_on_root::<M, N>(&forces);
+            elastic_forces_with_angles(frames, theta, &cos_sin, rest, clamped, terms, forces);
+            on_root += elastic_on_root::<M, N>(forces);
         }
         let nodes = Nodes::<M, N> {
             count: strand.rest.nodes,
@@ -406,24 +491,34 @@ fn explicit_substeps<M: Math, const N: usize>(
             velocity: &mut strand.state.velocity,
             inverse_mass: &strand.rest.inverse_mass,
         };
-        symplectic_euler(
-            nodes,
-            &external,
-            &forces,
-            h,
-            accelerations,
-            &mut motion,
-            true,
-        );
-        if let (Some(sub), true) = (&between, substep + 1 < k) {
+        symplectic_euler(nodes, &external, forces, h, accelerations, motion, true);
+        if between && substep + 1 < k {
             // Segment lengths between substeps; the step's own projection follows the last.
-            let mut scratch = StepReport::default();
-            on_root += project_constraints::<M, N>(strand, sub, &[], 0, &mut scratch).root_pull;
+            let projection = &mut solves.projection;
+            on_root += project_between_substeps::<M, N>(strand, ctx, h, projection);
             motion.restart(strand);
         }
     }
     // Each substep's forces act for h = dt/k: their mean over the step.
     (cos_sin, on_root * (1.0 / k as Real))
+}
+
+/// The segment lengths projected between two substeps of `h`
+/// ([`inextensibility_between_substeps`]) in the workspace `projection`. Returns the
+/// projection's pull on the held node 1. Out of line: the substeps' context and the report
+/// nobody reads stay off the frame of every strand's step (0.8 KB at 16 nodes on the
+/// Cortex-M4F); built for each projection, they cost a copy beside a projection.
+#[inline(never)]
+fn project_between_substeps<M: Math, const N: usize>(
+    strand: &mut Strand<N>,
+    ctx: &StepContext,
+    h: Real,
+    projection: &mut ProjectionScratch<N>,
+) -> Vec3 {
+    let sub = inextensibility_between_substeps(ctx, h);
+    let mut unread = StepReport::default();
+    let (at, mode) = ((&[][..], 0), sub.params.mode);
+    project_in_scratch::<M, N>(strand, &sub, at, mode, projection, &mut unread).root_pull
 }
 
 /// Lines 3–4 as one linearly implicit bending step of `dt` (`rod::implicit`): the elastic
@@ -438,7 +533,7 @@ fn implicit_bending<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     clamped: &ClampedSegments,
-    frames: &RodFrames<M, N>,
+    (frames, solves, forces): (&RodFrames<M, N>, &mut Solves<M, N>, &mut [Vec3; N]),
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> Integrated<N> {
@@ -448,12 +543,14 @@ fn implicit_bending<M: Math, const N: usize>(
     let terms = ElasticTerms::of(&ctx.gates);
     let segments = strand.rest.nodes.min(N).saturating_sub(1);
     let cos_sin = material_angles::<M, N>(&strand.state.theta[..segments]);
-    let mut forces = [Vec3::ZERO; N];
+    // Zero where the elastic forces write none.
+    *forces = [Vec3::ZERO; N];
     let (theta, rest) = (&strand.state.theta, &strand.rest.rod);
-    elastic_forces_with_angles(frames, theta, &cos_sin, rest, clamped, terms, &mut forces);
+    elastic_forces_with_angles(frames, theta, &cos_sin, rest, clamped, terms, forces);
     // The head's motion of nodes 0 and 1 this step: the solve's boundary condition.
     let held = [0, 1].map(|i| held_velocity(ctx, strand, i));
-    let on_root = implicit::step(strand, ctx, frames, &forces, held, accelerations);
+    let system = &mut solves.system;
+    let on_root = implicit::step(strand, ctx, (frames, system), forces, held, accelerations);
     (cos_sin, on_root)
 }
 

@@ -16,7 +16,7 @@
 use crate::context::StepContext;
 use crate::forces::{drag, External};
 use crate::grab::Grab;
-use crate::lane::{Lane, Lanes, Natural, Wide, WideMask, V3};
+use crate::lane::{Lane, Lanes, Wide, WideMask, V3};
 use crate::math::{Math, Real, Vec3};
 use crate::projection::lanes::{
     fits_lanes, project_alone, project_strand, BlockProjection, LaneEnding,
@@ -25,10 +25,10 @@ use crate::report::{Stage, StepReport};
 use crate::rod::block::LaneBlock;
 use crate::rod::energy::elastic_forces_with_angles;
 use crate::rod::frames::RodFrames;
-use crate::rod::implicit::{step_nodes, Loads};
+use crate::rod::implicit::{step_nodes, BendingSystem, Loads};
 use crate::rod::integrate::{starting_at, symplectic_euler, Nodes};
 use crate::rod::substeps::{
-    inextensibility_between_substeps, smallest_binormal_denominators_in_lanes, Integration,
+    projects_between_substeps, smallest_binormal_denominators_in_lanes, Integration,
 };
 use crate::rod::twist::{
     hair_optimised_twist_with_angles, newton_twist_in_lanes, ClampedFrames, NewtonSettings,
@@ -36,11 +36,11 @@ use crate::rod::twist::{
 };
 use crate::rod::{ClampedSegments, ElasticTerms, RootOnly};
 use crate::root_coupling::{elastic_on_root, held_velocity};
-use crate::strand::Strand;
+use crate::strand::{Strand, StrandState};
 
 use super::rod::{
-    begin, couple_root, integrate, judge, starting_from, transmit, twist_alone, Begun, RodScratch,
-    Starting,
+    begin, couple_root, integrate, judge, starting_from, transmit, twist_alone, Begun,
+    RodProjection, RodScratch, Starting,
 };
 
 /// Scratch space for [`step_block`], kept by the caller from step to step: the lanes, their
@@ -51,6 +51,8 @@ use super::rod::{
 pub struct RodBlockScratch<M: Math, const N: usize, const W: usize> {
     /// The block's lanes.
     block: LaneBlock<N, W>,
+    /// Each strand's last good state.
+    last_good: [StrandState<N>; W],
     /// The lanes' frames.
     lane_frames: RodFrames<Lanes<M, W>, N>,
     /// One strand's frames and projection.
@@ -66,6 +68,7 @@ impl<M: Math, const N: usize, const W: usize> RodBlockScratch<M, N, W> {
     pub const fn new() -> Self {
         RodBlockScratch {
             block: LaneBlock::EMPTY,
+            last_good: [const { StrandState::EMPTY }; W],
             lane_frames: RodFrames::empty(),
             strand: RodScratch::new(),
             projection: BlockProjection::new(),
@@ -175,6 +178,7 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
         let has_frames = ctx.gates.frames;
         let RodBlockScratch {
             block,
+            last_good,
             lane_frames,
             strand: alone,
             ..
@@ -186,8 +190,9 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
         } else {
             [2.0; W]
         };
-        for (lane, strand) in strands.iter_mut().enumerate().take(W) {
+        for ((lane, strand), kept) in strands.iter_mut().enumerate().zip(last_good).take(W) {
             let index = first_strand + lane as u32;
+            let at = (grabs, index);
             let started = match (self.lanes, has_frames.then_some(&mut alone.frames)) {
                 (true, Some(scratch)) if self.gathered[lane] => {
                     let starting = Starting {
@@ -198,14 +203,14 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
                             Some(ClampedFrames::save(scratch, &s.state.theta, clamped))
                         },
                     };
-                    begin(strand, ctx, grabs, index, starting, report)
+                    begin(strand, ctx, at, starting, kept, report)
                 }
                 (_, frames) => {
                     let frames = frames.map(|f| {
                         f.refresh(strand);
                         &*f
                     });
-                    begin(strand, ctx, grabs, index, starting_from(frames), report)
+                    begin(strand, ctx, at, starting_from(frames), kept, report)
                 }
             };
             self.begun[lane] = Some(started);
@@ -279,9 +284,10 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
                 alone.frames.refresh(strand);
                 &mut alone.frames
             });
+            let space = (frames, &mut alone.projection.solves, &mut alone.integration);
             let acc = of_strand(lane);
             (self.angles[lane], self.on_root[lane]) =
-                integrate(strand, ctx, begun, frames, acc, report);
+                integrate(strand, ctx, begun, space, acc, report);
         }
     }
 
@@ -302,6 +308,7 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
         }
         let RodBlockScratch {
             block,
+            last_good,
             lane_frames,
             strand: alone,
             projection,
@@ -331,7 +338,7 @@ impl<'s, M: Math, const N: usize, const W: usize> BlockStep<'s, M, N, W> {
                 twist_alone(strand, ctx, begun, frames, &self.angles[lane], report);
             }
             let index = first_strand + lane as u32;
-            let rolled_back = judge(strand, ctx, index, begun, report);
+            let rolled_back = judge(strand, ctx, index, &last_good[lane], report);
             let force = self.on_root[lane] + pulls[lane];
             transmit(strand, ctx, (grabs, index), (force, rolled_back), report);
         }
@@ -356,7 +363,7 @@ fn project<M: Math, const N: usize, const W: usize>(
     begun: &[Option<Begun<M, N>>; W],
     ctx: &StepContext,
     (grabs, first_strand): (&[Grab], u32),
-    ((lanes, ending), alone): ProjectionScratch<'_, N, W>,
+    ((lanes, ending), alone): ProjectionScratch<'_, M, N, W>,
     report: &mut StepReport,
 ) -> [Vec3; W] {
     let mut pulls = [Vec3::ZERO; W];
@@ -379,7 +386,7 @@ fn project<M: Math, const N: usize, const W: usize>(
         let outcome = if in_lanes && taken[lane] {
             lanes.finish::<M>(lane, strand, ctx, report, Some(&*ending))
         } else if taken[lane] {
-            project_alone::<M, N>(strand, ctx, alone, report)
+            project_alone::<M, N>(strand, ctx, &mut alone.lanes, report)
         } else {
             let at = (grabs, first_strand + lane as u32);
             project_strand::<M, N>(strand, ctx, at, alone, report)
@@ -390,9 +397,9 @@ fn project<M: Math, const N: usize, const W: usize>(
 }
 
 /// The projections' scratch space of a block: its lanes with their ending, and one strand's.
-type ProjectionScratch<'s, const N: usize, const W: usize> = (
+type ProjectionScratch<'s, M, const N: usize, const W: usize> = (
     (&'s mut BlockProjection<N, W>, &'s mut LaneEnding<N, W>),
-    &'s mut BlockProjection<N, 1, Natural>,
+    &'s mut RodProjection<M, N>,
 );
 
 /// Lines 9 (space) and 10 for the strands `in_lanes` names, in lanes: their new centrelines
@@ -491,10 +498,11 @@ fn implicit_in_lanes<M: Math, const N: usize, const W: usize>(
         accelerations: block.accelerations.as_ref().map(|a| &a[..]),
     };
     let h = Wide::splat(ctx.dt);
+    let mut system = BendingSystem::default();
     step_nodes(
         lane_nodes,
         &loads,
-        frames,
+        (frames, &mut system),
         (h, held),
         WideMask::from_bools(*implicit),
     )
@@ -502,7 +510,7 @@ fn implicit_in_lanes<M: Math, const N: usize, const W: usize>(
 
 /// Whether `k` substeps run without a projection between them (what the lanes do).
 fn plain(ctx: &StepContext, k: u32) -> bool {
-    inextensibility_between_substeps(ctx, k, ctx.dt / k as Real).is_none()
+    !projects_between_substeps(ctx, k)
 }
 
 /// `super::rod::explicit_substeps` of the lanes of `block`, lane `l` taking `substeps[l]` of

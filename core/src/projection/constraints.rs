@@ -267,12 +267,12 @@ impl Layout {
 /// The segments' share of the residual and the convergence test at the positions `at(i)`
 /// (segments with a free node, rest lengths `rest_length`), into `rows`: what the evaluation a
 /// fixed-cost projection stopped after did not measure ([`Layout::measures_segments`]).
-pub(crate) fn measure_segments<const N: usize>(
+pub(crate) fn measure_segments<const N: usize, const S: usize>(
     at: impl Fn(usize) -> Vec3,
     rest_length: &[Real; N],
     nodes: &Nodes<N>,
     tolerance: Real,
-    rows: &mut Rows<N>,
+    rows: &mut Rows<N, S>,
 ) {
     let count = nodes.count.min(N);
     for (i, &rest) in rest_length.iter().enumerate().take(count.saturating_sub(1)) {
@@ -285,18 +285,21 @@ pub(crate) fn measure_segments<const N: usize>(
     }
 }
 
-/// The constraints at one iterate: segment rows in band order, collision rows by node.
+/// The constraints at one iterate: segment rows in band order, collision rows by node. `S`
+/// is the segment rows' capacity: `N` for the general projection, 0 for a strand's lane in
+/// the lanes' projection, whose segment rows live in the lanes (`lanes::BlockProjection`;
+/// there they would be 56 bytes a node of a world's scratch space for nothing).
 #[derive(Clone, Debug, PartialEq)]
-pub struct Rows<const N: usize> {
+pub struct Rows<const N: usize, const S: usize = N> {
     /// The segment rows, in band order (`count` in use).
-    pub rows: [Row; N],
+    pub rows: [Row; S],
     /// First column of each row's envelope (`first[r] ≤ r`): the previous row when it shares
     /// a node with this one.
-    pub first: [u16; N],
+    pub first: [u16; S],
     /// Rows in use.
     pub count: usize,
     /// Row index of segment `j`, or [`NO_ROW`].
-    pub segment_row: [u16; N],
+    pub segment_row: [u16; S],
     /// Each node's collision rows (all empty, `kept = 0`, but those of `contact_nodes`).
     pub contacts: [NodeContacts; N],
     /// The nodes with collision rows at this iterate, in increasing order (`contact_count`
@@ -318,7 +321,7 @@ pub struct Rows<const N: usize> {
     pub tentative: bool,
 }
 
-impl<const N: usize> Default for Rows<N> {
+impl<const N: usize, const S: usize> Default for Rows<N, S> {
     // Inlined so that the arrays are filled in their final place (the projection's
     // workspace), not built on the stack and copied there.
     #[inline(always)]
@@ -327,16 +330,16 @@ impl<const N: usize> Default for Rows<N> {
     }
 }
 
-impl<const N: usize> Rows<N> {
+impl<const N: usize, const S: usize> Rows<N, S> {
     /// No rows (`const`: a world's scratch space is built at compile time).
     #[inline(always)]
     #[must_use]
     pub const fn new() -> Self {
         Rows {
-            rows: [Row::EMPTY; N],
-            first: [0; N],
+            rows: [Row::EMPTY; S],
+            first: [0; S],
             count: 0,
-            segment_row: [NO_ROW; N],
+            segment_row: [NO_ROW; S],
             contacts: [NodeContacts::EMPTY; N],
             contact_nodes: [0; N],
             contact_count: 0,
@@ -349,7 +352,7 @@ impl<const N: usize> Rows<N> {
     }
 }
 
-impl<const N: usize> Rows<N> {
+impl<const N: usize, const S: usize> Rows<N, S> {
     /// The rows in use.
     #[must_use]
     pub fn rows(&self) -> &[Row] {
@@ -528,7 +531,7 @@ pub fn evaluate<M: Math, const N: usize>(
     let at = |i: usize| x[i];
     let rest_length = &strand.rest.segment_length;
     let found = (memory, &mut *rows);
-    evaluate_contacts::<M, N>(
+    evaluate_contacts::<M, N, N>(
         (at, rest_length),
         nodes,
         colliders,
@@ -554,13 +557,13 @@ pub fn evaluate<M: Math, const N: usize>(
 /// the residual. [`evaluate`] lays the segments out after it; the projection of a block in
 /// lanes lays them out in lanes.
 #[inline(always)]
-pub fn evaluate_contacts<M: Math, const N: usize>(
+pub fn evaluate_contacts<M: Math, const N: usize, const S: usize>(
     (position, rest_length): (impl Fn(usize) -> Vec3, &[Real; N]),
     nodes: &Nodes<N>,
     colliders: &[(u8, Shape)],
     layout: Layout,
     tolerance: Real,
-    (memory, rows): (&mut ContactMemory<N>, &mut Rows<N>),
+    (memory, rows): (&mut ContactMemory<N>, &mut Rows<N, S>),
 ) {
     rows.count = 0;
     rows.residual = 0.0;
@@ -571,7 +574,7 @@ pub fn evaluate_contacts<M: Math, const N: usize>(
     // Without collision slots no node ever gets a contact (counts stay 0 from `Default`).
     if layout.contact_slots > 0 {
         let at = (position, rest_length);
-        detect_contacts::<M, N>(at, nodes, colliders, layout, tolerance, memory, rows);
+        detect_contacts::<M, N, S>(at, nodes, colliders, layout, tolerance, memory, rows);
     }
 }
 
@@ -636,14 +639,14 @@ fn beyond(shape: &Shape, p: Vec3, margin: Real) -> bool {
 /// The collision rows of every free node at this iterate (see [`evaluate`]). One collider
 /// at a time over the nodes, so that the common case — a node far from it — is a
 /// squared-distance test in a tight loop; each node still gets its rows in collider order.
-fn detect_contacts<M: Math, const N: usize>(
+fn detect_contacts<M: Math, const N: usize, const S: usize>(
     (x, rest_length): (impl Fn(usize) -> Vec3, &[Real; N]),
     nodes: &Nodes<N>,
     colliders: &[(u8, Shape)],
     layout: Layout,
     tolerance: Real,
     memory: &mut ContactMemory<N>,
-    rows: &mut Rows<N>,
+    rows: &mut Rows<N, S>,
 ) {
     let count = nodes.count.min(N);
     rows.forget_contacts();
@@ -710,7 +713,7 @@ struct Found {
     tentative: bool,
 }
 
-impl<const N: usize> Rows<N> {
+impl<const N: usize, const S: usize> Rows<N, S> {
     /// Empties the previous iterate's collision rows (every other node's are empty already).
     #[inline(always)]
     pub(crate) fn forget_contacts(&mut self) {

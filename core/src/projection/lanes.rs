@@ -32,9 +32,9 @@ use super::constraints::{
     evaluate_contacts, measure_segments, resolution_floor, ContactMemory, Layout, Nodes, Rows,
 };
 use super::{
-    conclude, felt_by_colliders, free_nodes, layout_of, project_constraints, prune_tentative,
+    conclude, felt_by_colliders, free_nodes, layout_of, project_in_scratch, prune_tentative,
     push_on_colliders, record_outcome, segment_stretch, trust_radius, trust_scale,
-    usable_colliders, Findings, NearColliders, Outcome,
+    usable_colliders, Findings, NearColliders, Outcome, ProjectionScratch,
 };
 
 /// Whether strand `strand` (index `index` in the scene) can be projected in lanes with
@@ -61,19 +61,66 @@ pub fn fits_lanes<const N: usize>(
 /// a strand laid out as most are ([`fits_lanes`]: no grab, every node past the root's two
 /// free) through the lanes' kernel at one lane, which knows its rows' layout in advance; any
 /// other through the general projection, which lays its rows out each iteration. What the
-/// rod's step calls for one strand; `scratch` is the lanes' space ([`project_alone`]).
+/// rod's step calls for one strand, in `space` ([`StrandSpace`]).
 pub fn project_strand<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
     (grabs, strand_index): (&[Grab], u32),
-    scratch: &mut BlockProjection<N, 1, Natural>,
+    space: &mut impl StrandSpace<N>,
     report: &mut StepReport,
 ) -> Outcome {
     let nodes = strand.rest.nodes.min(N);
     if fits_lanes(strand, ctx, grabs, strand_index, nodes) {
-        project_alone::<M, N>(strand, ctx, scratch, report)
+        project_alone::<M, N>(strand, ctx, space.lanes(), report)
     } else {
-        project_constraints::<M, N>(strand, ctx, grabs, strand_index, report)
+        let (at, mode) = ((grabs, strand_index), ctx.params.mode);
+        space.general(|work| project_in_scratch::<M, N>(strand, ctx, at, mode, work, report))
+    }
+}
+
+/// Where [`project_strand`] projects one strand, kept by its caller (a rod `World`'s, inside
+/// `hairsim_init`'s buffer): the lanes' space at one lane, and the general projection's
+/// workspace. Nothing in either carries from one strand or step to the next. On the stack,
+/// the general projection's workspace was the deepest frame of a rod step on the Cortex-M4F
+/// (3.4 KB of its 10 KB at 16 nodes).
+pub trait StrandSpace<const N: usize> {
+    /// The lanes' space at one lane.
+    fn lanes(&mut self) -> &mut BlockProjection<N, 1, Natural>;
+
+    /// `project` run in the general projection's workspace.
+    fn general(&mut self, project: impl FnOnce(&mut ProjectionScratch<N>) -> Outcome) -> Outcome;
+}
+
+/// A [`StrandSpace`] that holds both spaces at once.
+pub struct StrandProjection<const N: usize> {
+    lanes: BlockProjection<N, 1, Natural>,
+    general: ProjectionScratch<N>,
+}
+
+impl<const N: usize> StrandProjection<N> {
+    /// Before its first use.
+    #[must_use]
+    pub const fn new() -> Self {
+        StrandProjection {
+            lanes: BlockProjection::new(),
+            general: ProjectionScratch::new(),
+        }
+    }
+}
+
+impl<const N: usize> Default for StrandProjection<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> StrandSpace<N> for StrandProjection<N> {
+    fn lanes(&mut self) -> &mut BlockProjection<N, 1, Natural> {
+        &mut self.lanes
+    }
+
+    fn general(&mut self, project: impl FnOnce(&mut ProjectionScratch<N>) -> Outcome) -> Outcome {
+        project(&mut self.general)
     }
 }
 
@@ -97,8 +144,8 @@ pub(crate) fn project_alone<M: Math, const N: usize>(
 /// the segment rows.
 struct Lane<const N: usize> {
     nodes: Nodes<N>,
-    /// The contacts (the segment rows live in the lanes).
-    rows: Rows<N>,
+    /// The contacts (the segment rows live in the lanes: no capacity for them here).
+    rows: Rows<N, 0>,
     contacts: ContactMemory<N>,
     collider_push: [Vec3; MAX_COLLIDERS],
     /// Segment 1's pull on the held node 1, × h² (`super::pull_on_root`).
@@ -238,7 +285,8 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
         for (l, book) in self.lanes.iter_mut().enumerate() {
             let strand = source(l);
             book.nodes = free_nodes(strand, nodes);
-            book.near = NearColliders::new(strand, &book.nodes, shapes, layout.contact_slots > 0);
+            book.near
+                .restart(strand, &book.nodes, shapes, layout.contact_slots > 0);
             book.contacts.forget();
             book.collider_push = [Vec3::ZERO; MAX_COLLIDERS];
             book.root_pull = Vec3::ZERO;
@@ -404,7 +452,7 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             let near = book.near.shapes(shapes);
             let found = (&mut book.contacts, &mut book.rows);
             let nodes = &book.nodes;
-            evaluate_contacts::<M, N>((at, rest_length), nodes, near, layout, tolerance, found);
+            evaluate_contacts::<M, N, 0>((at, rest_length), nodes, near, layout, tolerance, found);
         }
         let two = Wide::new([2.0; W]);
         let mut met = Met {
@@ -501,7 +549,7 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             book.root_pull -= at_root * (self.multipliers[0].0[l] * scale.0[l]);
             if any_contact[l] {
                 let (gradient, multipliers) = (&self.gradient, &self.multipliers);
-                let pull = |_: &Rows<N>, i| segment_pull(gradient, multipliers, n, i, l);
+                let pull = |_: &Rows<N, 0>, i| segment_pull(gradient, multipliers, n, i, l);
                 let memory = (&mut book.contacts, &mut book.collider_push);
                 let inverse_mass = &book.nodes.inverse_mass;
                 push_on_colliders(&book.rows, memory, inverse_mass, n, scale.0[l], pull);
@@ -598,7 +646,7 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
                     continue;
                 }
                 let (gradient, multipliers) = (&self.gradient, &self.multipliers);
-                let pull = |_: &Rows<N>, i| segment_pull(gradient, multipliers, n, i, l);
+                let pull = |_: &Rows<N, 0>, i| segment_pull(gradient, multipliers, n, i, l);
                 let inverse_mass = &book.nodes.inverse_mass;
                 if !prune_tentative(&mut book.rows, inverse_mass, n, pass >= 2, pull) {
                     solving.set(l, false);

@@ -95,15 +95,43 @@ impl defmt::Format for Outcome {
 /// projection reads before it writes it, so the workspace's past never reaches the bits; a
 /// fresh workspace's zero fills were a tenth of a held strand's projection on the
 /// Cortex-M4F, and its kilobytes a step's deepest stack frame.
-pub struct ProjectionScratch<const N: usize>(Workspace<N>);
+pub struct ProjectionScratch<const N: usize> {
+    work: Workspace<N>,
+    colliders: ColliderSpace,
+}
 
 impl<const N: usize> ProjectionScratch<N> {
     /// Before its first use.
     #[must_use]
     pub const fn new() -> Self {
-        ProjectionScratch(Workspace::empty())
+        ProjectionScratch {
+            work: Workspace::empty(),
+            colliders: ColliderSpace::EMPTY,
+        }
     }
 }
+
+/// The colliders a projection tests: the step's usable ones ([`usable_colliders_into`]) and
+/// those near the strand ([`NearColliders`]). Kept beside the workspace: in a projection's own
+/// frame they were 620 bytes of the stack at every step on the Cortex-M4F.
+struct ColliderSpace {
+    shapes: [(u8, Shape); MAX_COLLIDERS],
+    near: NearColliders,
+}
+
+impl ColliderSpace {
+    /// Before its first use.
+    const EMPTY: ColliderSpace = ColliderSpace {
+        shapes: [(0, PLACEHOLDER); MAX_COLLIDERS],
+        near: NearColliders::none(),
+    };
+}
+
+/// What an unused collider slot holds.
+const PLACEHOLDER: Shape = Shape::Plane {
+    point: Vec3::ZERO,
+    normal: Vec3::Y,
+};
 
 impl<const N: usize> Default for ProjectionScratch<N> {
     fn default() -> Self {
@@ -168,7 +196,9 @@ pub fn project_constraints<M: Math, const N: usize>(
 }
 
 /// [`project_constraints`] in `mode` rather than the scene's, in a workspace of its own on
-/// the stack.
+/// the stack. Never inlined: its kilobytes stay off the frames of callers that keep a
+/// workspace and call it only without one (a DFTL step, `pipeline::dftl`).
+#[inline(never)]
 pub(crate) fn project_in_mode<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
@@ -180,7 +210,8 @@ pub(crate) fn project_in_mode<M: Math, const N: usize>(
         return Outcome::default();
     }
     let mut work = Workspace::new(strand, strand.rest.nodes.min(N));
-    project_in::<M, N>(strand, ctx, at, mode, &mut work, report)
+    let mut colliders = ColliderSpace::EMPTY;
+    project_in::<M, N>(strand, ctx, at, mode, (&mut work, &mut colliders), report)
 }
 
 /// [`project_in_mode`] in the workspace `scratch` its caller keeps (DFTL's held strands, in
@@ -196,8 +227,9 @@ pub(crate) fn project_in_scratch<M: Math, const N: usize>(
     if !projects(ctx) {
         return Outcome::default();
     }
-    scratch.0.reset(strand, strand.rest.nodes.min(N));
-    project_in::<M, N>(strand, ctx, at, mode, &mut scratch.0, report)
+    scratch.work.reset(strand, strand.rest.nodes.min(N));
+    let space = (&mut scratch.work, &mut scratch.colliders);
+    project_in::<M, N>(strand, ctx, at, mode, space, report)
 }
 
 /// Whether a projection runs: when any of `inextensibility`, `collisions`, `grabs` is on.
@@ -214,7 +246,7 @@ fn project_in<M: Math, const N: usize>(
     ctx: &StepContext,
     (grabs, strand_index): (&[Grab], u32),
     mode: Mode,
-    work: &mut Workspace<N>,
+    (work, colliders): (&mut Workspace<N>, &mut ColliderSpace),
     report: &mut StepReport,
 ) -> Outcome {
     #[allow(clippy::let_unit_value)]
@@ -226,11 +258,11 @@ fn project_in<M: Math, const N: usize>(
     let n = strand.rest.nodes.min(N);
     let held = grabbed_nodes(ctx, grabs, strand_index, n);
     prescribe_grabs::<M, N>(strand, ctx, grabs, &held, work);
-    let mut shape_count = 0;
-    let shapes = usable_colliders(ctx, &mut shape_count);
+    let shape_count = usable_colliders_into(ctx, &mut colliders.shapes);
     let layout = layout_in_mode(ctx, shape_count, mode);
-    let shapes = shapes.get(..shape_count).unwrap_or(&[]);
-    let outcome = iterate::<M, N>(strand, ctx, shapes, layout, &held, work);
+    let shapes = colliders.shapes.get(..shape_count).unwrap_or(&[]);
+    let near = &mut colliders.near;
+    let outcome = iterate::<M, N>(strand, ctx, (shapes, near), layout, &held, work);
     let findings = Findings {
         touched: &work.contacts.touched,
         max_depth: work.rows.max_depth,
@@ -436,20 +468,32 @@ pub(crate) fn usable_colliders(
     ctx: &StepContext,
     count: &mut usize,
 ) -> [(u8, Shape); MAX_COLLIDERS] {
+    // A local, not `PLACEHOLDER`: the constant was copied into each slot by a library call
+    // (8.5 k instructions a step of the 32-node rod on the Cortex-M4F).
     let placeholder = Shape::Plane {
         point: Vec3::ZERO,
         normal: Vec3::Y,
     };
     let mut shapes = [(0, placeholder); MAX_COLLIDERS];
-    *count = 0;
+    *count = usable_colliders_into(ctx, &mut shapes);
+    shapes
+}
+
+/// [`usable_colliders`] written into `slots` in place; returns how many. The slots past them
+/// keep what they held.
+pub(crate) fn usable_colliders_into(
+    ctx: &StepContext,
+    slots: &mut [(u8, Shape); MAX_COLLIDERS],
+) -> usize {
+    let mut count = 0;
     for (c, shape) in ctx.colliders().iter().enumerate().take(MAX_COLLIDERS) {
-        if let (true, Some(slot)) = (shape.is_valid(), shapes.get_mut(*count)) {
+        if let (true, Some(slot)) = (shape.is_valid(), slots.get_mut(count)) {
             // `c < MAX_COLLIDERS = 8`: fits a u8 and the per-node contact bit mask.
             *slot = (c as u8, *shape);
-            *count += 1;
+            count += 1;
         }
     }
-    shapes
+    count
 }
 
 /// Grabbed nodes: a prescribed one is moved to its target, with infinite mass and no rows
@@ -543,7 +587,7 @@ fn coupled_node(
 fn iterate<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    shapes: &[(u8, Shape)],
+    (shapes, near): (&[(u8, Shape)], &mut NearColliders),
     layout: Layout,
     held: &GrabbedNodes,
     work: &mut Workspace<N>,
@@ -551,7 +595,7 @@ fn iterate<M: Math, const N: usize>(
     let cap = u32::from(ctx.params.rod.projection_iterations);
     let tolerance = ctx.params.rod.projection_tolerance;
     let mut outcome = Outcome::default();
-    let mut near = NearColliders::new(strand, &work.nodes, shapes, layout.contact_slots > 0);
+    near.restart(strand, &work.nodes, shapes, layout.contact_slots > 0);
     for k in 0..=cap {
         // After the last solve only the residual is wanted: no rows.
         let layout = Layout {
@@ -648,16 +692,29 @@ fn larger(a: Vec3, b: Vec3) -> Vec3 {
 }
 
 impl NearColliders {
+    /// [`Self::restart`] of [`Self::none`] (a projection restarts the one it keeps).
+    #[cfg(test)]
     pub(crate) fn new<const N: usize>(
         strand: &Strand<N>,
         nodes: &constraints::Nodes<N>,
         shapes: &[(u8, Shape)],
         collisions: bool,
     ) -> Self {
-        let placeholder = Shape::Plane {
-            point: Vec3::ZERO,
-            normal: Vec3::Y,
-        };
+        let mut near = NearColliders::none();
+        near.restart(strand, nodes, shapes, collisions);
+        near
+    }
+
+    /// For a projection's start, in place: the free nodes' box (of `strand`'s free `nodes`;
+    /// none without `collisions` or `shapes`), nothing near yet (the near list is read only
+    /// as far as it is written, so it is not cleared).
+    pub(crate) fn restart<const N: usize>(
+        &mut self,
+        strand: &Strand<N>,
+        nodes: &constraints::Nodes<N>,
+        shapes: &[(u8, Shape)],
+        collisions: bool,
+    ) {
         let mut low = Vec3::splat(Real::MAX);
         let mut high = Vec3::splat(-Real::MAX);
         // NaN and infinities propagate into the sum where min/max would hide them.
@@ -674,26 +731,18 @@ impl NearColliders {
                 }
             }
         }
-        let rounding = 1.0e-5 * magnitude(low).max(magnitude(high)) + 1.0e-6;
-        NearColliders {
-            low,
-            high,
-            rounding,
-            grown: 0.0,
-            free,
-            bounded: crate::math::is_finite(sum),
-            mask: 0,
-            near: [(0, placeholder); MAX_COLLIDERS],
-            count: 0,
-        }
+        self.rounding = 1.0e-5 * magnitude(low).max(magnitude(high)) + 1.0e-6;
+        self.low = low;
+        self.high = high;
+        self.grown = 0.0;
+        self.free = free;
+        self.bounded = crate::math::is_finite(sum);
+        self.mask = 0;
+        self.count = 0;
     }
 
     /// No collider near: for a scratch space before its first use.
     pub(crate) const fn none() -> Self {
-        let placeholder = Shape::Plane {
-            point: Vec3::ZERO,
-            normal: Vec3::Y,
-        };
         NearColliders {
             low: Vec3::ZERO,
             high: Vec3::ZERO,
@@ -702,7 +751,7 @@ impl NearColliders {
             free: false,
             bounded: false,
             mask: 0,
-            near: [(0, placeholder); MAX_COLLIDERS],
+            near: [(0, PLACEHOLDER); MAX_COLLIDERS],
             count: 0,
         }
     }
@@ -973,13 +1022,13 @@ fn push_on_colliders_alone<const N: usize>(
 /// pushes: a contact from now on). `segment_pull(rows, i)` is `Σ_s ∇_{x_i}C_s δλ_s` over the
 /// segments through node `i` ([`segment_pull_on_node`] for one strand).
 #[inline(always)]
-pub(crate) fn push_on_colliders<const N: usize>(
-    rows: &Rows<N>,
+pub(crate) fn push_on_colliders<const N: usize, const S: usize>(
+    rows: &Rows<N, S>,
     (memory, collider_push): (&mut ContactMemory<N>, &mut [Vec3; MAX_COLLIDERS]),
     inverse_mass: &[Real; N],
     n: usize,
     scale: Real,
-    segment_pull: impl Fn(&Rows<N>, usize) -> Vec3,
+    segment_pull: impl Fn(&Rows<N, S>, usize) -> Vec3,
 ) {
     for k in 0..rows.contact_count.min(N) {
         let i = usize::from(rows.contact_nodes[k]);
@@ -1014,12 +1063,12 @@ pub(crate) fn push_on_colliders<const N: usize>(
 /// would hold its node at the surface against the segments pulling it away), or every
 /// tentative row when `all`. Returns whether any row was removed (the system must be solved
 /// again); `rows.tentative` then says whether tentative rows are left.
-pub(crate) fn prune_tentative<const N: usize>(
-    rows: &mut Rows<N>,
+pub(crate) fn prune_tentative<const N: usize, const S: usize>(
+    rows: &mut Rows<N, S>,
     inverse_mass: &[Real; N],
     n: usize,
     all: bool,
-    segment_pull: impl Fn(&Rows<N>, usize) -> Vec3,
+    segment_pull: impl Fn(&Rows<N, S>, usize) -> Vec3,
 ) -> bool {
     let mut removed = false;
     let mut left = false;

@@ -708,7 +708,7 @@ fn the_lanes_kernel_and_the_general_one_give_the_same_bits() {
                     assert!(lanes::fits_lanes(&strand, &ctx, &[], 0, 20));
                     let mut general = strand.clone();
                     let (mut a, mut b) = (StepReport::default(), StepReport::default());
-                    let mut scratch = lanes::BlockProjection::default();
+                    let mut scratch = lanes::StrandProjection::default();
                     let at = (&[][..], 0);
                     let outcome = lanes::project_strand::<Libm, N>(
                         &mut strand,

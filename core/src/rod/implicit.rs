@@ -76,6 +76,16 @@ impl<P: Kernel, const N: usize> Default for BendingSystem<P, N> {
     }
 }
 
+impl<M: Math, const N: usize> BendingSystem<M, N> {
+    /// One strand's, before its first use (`const`: a world's scratch space).
+    pub const EMPTY: Self = BendingSystem {
+        band: [[[0.0; BAND + 1]; 3]; N],
+        inverse_pivot: [[0.0; 3]; N],
+        nodes: 0,
+        pivot_floor: 0.0,
+    };
+}
+
 /// Smallest pivot the factorisation keeps, relative to its row's diagonal: 2⁻²⁰, eight units
 /// in the last place of an f32 (a pivot smaller than that is what is left of the diagonal
 /// after cancellation, rounding noise; see `factor_row`).
@@ -595,7 +605,7 @@ pub struct Loads<'a, P: Kernel, const N: usize> {
 pub fn step<M: Math, const N: usize>(
     strand: &mut Strand<N>,
     ctx: &StepContext,
-    frames: &RodFrames<M, N>,
+    (frames, system): (&RodFrames<M, N>, &mut BendingSystem<M, N>),
     forces: &[Vec3; N],
     held_velocity: [Vec3; 2],
     accelerations: Option<&[Vec3]>,
@@ -616,21 +626,29 @@ pub fn step<M: Math, const N: usize>(
         external: &external,
         accelerations,
     };
-    step_nodes(nodes, &loads, frames, (ctx.dt, held_velocity), true)
+    step_nodes(
+        nodes,
+        &loads,
+        (frames, system),
+        (ctx.dt, held_velocity),
+        true,
+    )
 }
 
 /// [`step`] of one strand's nodes or of `W` strands' in lanes (`lane::Lanes`): the same
 /// operations on each lane. Lanes outside `active` keep their positions and velocities (a
-/// strand in a block that takes the explicit substeps): `true` for one strand.
+/// strand in a block that takes the explicit substeps): `true` for one strand. `system` is
+/// the caller's space for the system: [`BendingSystem::assemble`] writes every entry that
+/// [`BendingSystem::factor`] and [`BendingSystem::solve`] read (those of the strand's rows),
+/// so what it held before never reaches the bits.
 pub fn step_nodes<P: Kernel, const N: usize>(
     nodes: Nodes<'_, P, N>,
     loads: &Loads<'_, P, N>,
-    frames: &RodFrames<P, N>,
+    (frames, system): (&RodFrames<P, N>, &mut BendingSystem<P, N>),
     (h, held_velocity): (P::R, [P::V; 2]),
     active: <P::R as Arithmetic>::Mask,
 ) -> P::V {
     let n = nodes.count.min(N);
-    let mut system = BendingSystem::<P, N>::default();
     system.assemble(frames, loads.mass, loads.rest, h);
     system.factor();
     // Right-hand side M (v + h a), with a as in the explicit step.

@@ -31,9 +31,11 @@ impl<const N: usize> Motion<N> {
         }
     }
 
-    /// Counts again from the strand's positions now (after something else moved them).
+    /// Counts again from the strand's positions now (after something else moved them), in
+    /// place (a new `Motion` moved in was a copy through the stack).
     pub fn restart(&mut self, strand: &Strand<N>) {
-        *self = Motion::from(strand);
+        self.start = strand.state.position;
+        self.displacement = [Vec3::ZERO; N];
     }
 }
 

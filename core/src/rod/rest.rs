@@ -65,7 +65,10 @@ impl<const N: usize, R: Scalar> RodRest<N, R> {
         }
         let shortest = self.lengths::<P>(points, bending_stiffness);
         let root_frame = rest_root_frame::<P>(points[0], points[1], self.rest_length[0]);
-        let frames = RodFrames::<P, N>::compute(&points[..nodes], root_frame, &self.rest_length);
+        // Computed where they lie: returned by `RodFrames::compute`, they were a copy, the
+        // deepest frame of adding a strand (3 KB at 32 nodes).
+        let mut frames = RodFrames::<P, N>::empty();
+        frames.recompute(&points[..nodes], root_frame, &self.rest_length);
         self.angles_and_curvatures(&frames, segments);
         let stiffest = if minor_axis_penalty > R::ONE {
             minor_axis_penalty * bending_stiffness

@@ -320,10 +320,17 @@ pub const PROJECTED_SUBSTEPS_FROM: u32 = 8;
 /// nothing; the step's own projection still meets the scene's tolerance.
 pub const SUBSTEP_PROJECTION_TOLERANCE: Real = 1.0e-4;
 
-/// The context of the inextensibility projection run between substeps (`None` below
-/// [`PROJECTED_SUBSTEPS_FROM`] substeps or without `inextensibility`): the substep's `h`,
-/// inextensibility only (contacts and grabs wait for the step's own projection, with the
-/// head's end-of-step pose).
+/// Whether `k` substeps project the segment lengths between them
+/// ([`inextensibility_between_substeps`]).
+#[inline(always)]
+#[must_use]
+pub fn projects_between_substeps(ctx: &StepContext, k: u32) -> bool {
+    k >= PROJECTED_SUBSTEPS_FROM && ctx.has(Effect::Inextensibility)
+}
+
+/// The context of the inextensibility projection run between substeps of `h` (when
+/// [`projects_between_substeps`]): the substep's `h`, inextensibility only (contacts and grabs
+/// wait for the step's own projection, with the head's end-of-step pose).
 ///
 /// Why: the substeps resolve bending's fast modes, but a curved strand's bending forces have
 /// components along its segments, and without the constraint those move freely for the whole
@@ -331,10 +338,9 @@ pub const SUBSTEP_PROJECTION_TOLERANCE: Real = 1.0e-4;
 /// 1 ms, the step's projection snapped it back (`v += Δx/dt`), and it blew up within 30 steps
 /// even on a still head; with the lengths kept at every substep it holds
 /// (`tests/torture.rs`). Cost: `k − 1` more tridiagonal projections per step.
-pub fn inextensibility_between_substeps(ctx: &StepContext, k: u32, h: Real) -> Option<StepContext> {
-    if k < PROJECTED_SUBSTEPS_FROM || !ctx.has(Effect::Inextensibility) {
-        return None;
-    }
+#[inline(always)]
+#[must_use]
+pub fn inextensibility_between_substeps(ctx: &StepContext, h: Real) -> StepContext {
     let mut sub = ctx.clone();
     sub.dt = h;
     sub.inv_dt = 1.0 / h;
@@ -349,7 +355,7 @@ pub fn inextensibility_between_substeps(ctx: &StepContext, k: u32, h: Real) -> O
     if sub.params.rod.projection_tolerance < SUBSTEP_PROJECTION_TOLERANCE {
         sub.params.rod.projection_tolerance = SUBSTEP_PROJECTION_TOLERANCE;
     }
-    Some(sub)
+    sub
 }
 
 impl Params {
