@@ -434,46 +434,86 @@ fn a_kept_dftl_scratch_carries_nothing_between_strands_or_steps() {
     );
 }
 
+/// Strand `s` of the world scratch tests: `nodes` nodes draped out from the head's sphere,
+/// wavy, of `material`.
+fn scratch_test_strand(
+    s: usize,
+    nodes: usize,
+    material: &hairsim_core::Material,
+) -> hairsim_core::Strand<24> {
+    use hairsim_core::{Real, Strand, Vec3};
+    let normal = Vec3::new(0.3 * s as Real - 0.3, 0.9, 0.2).normalize();
+    let side = normal.cross(Vec3::Z).normalize();
+    let points: Vec<Vec3> = (0..nodes)
+        .map(|i| {
+            let a = i as Real * (0.5 + 0.3 * s as Real);
+            normal * (0.051 + i as Real * 0.008) + side * (0.004 * a.sin())
+        })
+        .collect();
+    Strand::from_polyline(&points, material).unwrap()
+}
+
+/// A world of the world scratch tests: `params`, the head's sphere and `strands`.
+fn scratch_test_world(
+    params: hairsim_core::Params,
+    strands: impl IntoIterator<Item = hairsim_core::Strand<24>>,
+) -> Box<World<3, 24, Libm>> {
+    use hairsim_core::collide::{Collider, Shape};
+    use hairsim_core::Vec3;
+    let mut world: Box<World<3, 24, Libm>> = Box::default();
+    world.configure(params).unwrap();
+    let sphere = Collider {
+        shape: Shape::Sphere {
+            centre: Vec3::ZERO,
+            radius: 0.05,
+        },
+        attached_to_head: true,
+    };
+    world.add_collider(sphere).unwrap();
+    for strand in strands {
+        world.add_strand(strand).unwrap();
+    }
+    world
+}
+
+/// Asserts that strand `s` of `together` has the positions and twist bits of the one strand
+/// of `alone` at step `k`.
+fn assert_same_strand_bits(
+    together: &World<3, 24, Libm>,
+    alone: &World<3, 24, Libm>,
+    s: usize,
+    k: u32,
+) {
+    let bits = |p: &[hairsim_core::Vec3]| {
+        p.iter()
+            .map(|v| v.to_array().map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(
+        bits(together.strands()[s].positions()),
+        bits(alone.strands()[0].positions()),
+        "strand {s}, step {k}"
+    );
+    assert_eq!(
+        together.strands()[s].state.theta.map(f32::to_bits),
+        alone.strands()[0].state.theta.map(f32::to_bits),
+        "strand {s}, step {k}"
+    );
+}
+
 /// A `World` keeps the rod step's scratch space (`RodScratch`: the frames' buffer, the
-/// projection's lanes and the rest) from strand to strand and step to step. Nothing may carry over: three
-/// strands of 24, 13 and 19 nodes in one world, where each strand's step finds the buffer as
-/// a longer or shorter strand left it, give the bits each gives alone in a world of its own,
-/// every step of 800 with bending, twist, inextensibility and the head's sphere on a shaking
-/// head.
+/// projection's lanes and the rest) from strand to strand and step to step. Nothing may carry
+/// over: three strands of 24, 13 and 19 nodes in one world, where each strand's step finds the
+/// buffer as a longer or shorter strand left it, give the bits each gives alone in a world of
+/// its own, every step of 800 with bending, twist, inextensibility and the head's sphere on a
+/// shaking head.
 #[test]
 fn a_worlds_rod_scratch_carries_nothing_between_strands_or_steps() {
-    use hairsim_core::collide::{Collider, Shape};
-    use hairsim_core::{Material, Real, Shake, StepInput, Strand, Vec3};
-    const N: usize = 24;
+    use hairsim_core::{Material, Real, Shake, StepInput};
     let params = scratch_test_params();
-    let strand = |s: usize, nodes: usize| {
-        let normal = Vec3::new(0.3 * s as Real - 0.3, 0.9, 0.2).normalize();
-        let side = normal.cross(Vec3::Z).normalize();
-        let points: Vec<Vec3> = (0..nodes)
-            .map(|i| {
-                let a = i as Real * (0.5 + 0.3 * s as Real);
-                normal * (0.051 + i as Real * 0.008) + side * (0.004 * a.sin())
-            })
-            .collect();
-        Strand::<N>::from_polyline(&points, &Material::HUMAN_HAIR).unwrap()
-    };
     let lengths = [24, 13, 19];
-    let build = |which: &[usize]| {
-        let mut world: Box<World<3, N, Libm>> = Box::default();
-        world.configure(params).unwrap();
-        let sphere = Collider {
-            shape: Shape::Sphere {
-                centre: Vec3::ZERO,
-                radius: 0.05,
-            },
-            attached_to_head: true,
-        };
-        world.add_collider(sphere).unwrap();
-        for &s in which {
-            world.add_strand(strand(s, lengths[s])).unwrap();
-        }
-        world
-    };
+    let strand = |s: usize| scratch_test_strand(s, lengths[s], &Material::HUMAN_HAIR);
+    let build = |which: &[usize]| scratch_test_world(params, which.iter().map(|&s| strand(s)));
     let mut together = build(&[0, 1, 2]);
     let mut alone: Vec<_> = (0..3).map(|s| build(&[s])).collect();
     for k in 0..800u32 {
@@ -484,21 +524,7 @@ fn a_worlds_rod_scratch_carries_nothing_between_strands_or_steps() {
         together.step(&input);
         for (s, world) in alone.iter_mut().enumerate() {
             world.step(&input);
-            let bits = |p: &[Vec3]| {
-                p.iter()
-                    .map(|v| v.to_array().map(f32::to_bits))
-                    .collect::<Vec<_>>()
-            };
-            assert_eq!(
-                bits(together.strands()[s].positions()),
-                bits(world.strands()[0].positions()),
-                "strand {s}, step {k}"
-            );
-            assert_eq!(
-                together.strands()[s].state.theta.map(f32::to_bits),
-                world.strands()[0].state.theta.map(f32::to_bits),
-                "strand {s}, step {k}"
-            );
+            assert_same_strand_bits(&together, world, s, k);
         }
     }
 }
@@ -506,33 +532,23 @@ fn a_worlds_rod_scratch_carries_nothing_between_strands_or_steps() {
 /// The rod's scratch space also holds the general projection's workspace and the implicit
 /// step's system, which a held strand uses every step, and the explicit substeps' forces and
 /// motion. Nothing may carry over between strands that use them in turn: a held strand of 24
-/// nodes (its tip coupled to a circle: the implicit step, then the general projection), a strand of
-/// 13 nodes ten times stiffer (the implicit step, then the lanes' projection) and one of 19
-/// (the explicit substeps) in one world give the bits each gives alone, every step of 600 on
-/// a shaking head with the head's sphere.
+/// nodes (its tip coupled to a circle: the implicit step, then the general projection), a
+/// strand of 13 nodes ten times stiffer (the implicit step, then the lanes' projection) and
+/// one of 19 (the explicit substeps) in one world give the bits each gives alone, every step
+/// of 600 on a shaking head with the head's sphere.
 #[test]
 fn a_worlds_rod_scratch_carries_nothing_between_held_stiff_and_free_strands() {
-    use hairsim_core::collide::{Collider, Shape};
-    use hairsim_core::{Coupling, Effect, Grab, Material, Real, Shake, StepInput, Strand, Vec3};
-    const N: usize = 24;
+    use hairsim_core::{Coupling, Effect, Grab, Material, Real, Shake, StepInput, Vec3};
     let mut params = scratch_test_params();
     params.effects = params.effects.with(Effect::Grabs);
     let lengths = [24, 13, 19];
     let strand = |s: usize| {
-        let normal = Vec3::new(0.3 * s as Real - 0.3, 0.9, 0.2).normalize();
-        let side = normal.cross(Vec3::Z).normalize();
-        let points: Vec<Vec3> = (0..lengths[s])
-            .map(|i| {
-                let a = i as Real * (0.5 + 0.3 * s as Real);
-                normal * (0.051 + i as Real * 0.008) + side * (0.004 * a.sin())
-            })
-            .collect();
         let mut material = Material::HUMAN_HAIR;
         if s == 1 {
             material.youngs_modulus *= 10.0;
             material.shear_modulus *= 10.0;
         }
-        Strand::<N>::from_polyline(&points, &material).unwrap()
+        scratch_test_strand(s, lengths[s], &material)
     };
     let tip = strand(0).positions()[23];
     let target = |k: u32| {
@@ -540,35 +556,18 @@ fn a_worlds_rod_scratch_carries_nothing_between_held_stiff_and_free_strands() {
         tip + Vec3::new((20.0 * t).cos() - 1.0, 0.0, (20.0 * t).sin()) * 0.01
     };
     let build = |which: &[usize]| {
-        let mut world: Box<World<3, N, Libm>> = Box::default();
-        world.configure(params).unwrap();
-        let sphere = Collider {
-            shape: Shape::Sphere {
-                centre: Vec3::ZERO,
-                radius: 0.05,
-            },
-            attached_to_head: true,
-        };
-        world.add_collider(sphere).unwrap();
-        for (index, &s) in which.iter().enumerate() {
-            world.add_strand(strand(s)).unwrap();
-            if s == 0 {
-                // Coupled: a prescribed node slips once the shaking head takes the root out
-                // of reach of the target.
-                let coupling = Coupling::new(50.0, 0.05);
-                let grab = Grab::new(index as u32, 23, tip, 1000.0).with_coupling(coupling);
-                world.add_grab(grab).unwrap();
-            }
+        let mut world = scratch_test_world(params, which.iter().map(|&s| strand(s)));
+        if let Some(held) = which.iter().position(|&s| s == 0) {
+            // Coupled: a prescribed node slips once the shaking head takes the root out of
+            // reach of the target.
+            let coupling = Coupling::new(50.0, 0.05);
+            let grab = Grab::new(held as u32, 23, tip, 1000.0).with_coupling(coupling);
+            world.add_grab(grab).unwrap();
         }
         world
     };
     let mut together = build(&[0, 1, 2]);
     let mut alone: Vec<_> = (0..3).map(|s| build(&[s])).collect();
-    let bits = |p: &[Vec3]| {
-        p.iter()
-            .map(|v| v.to_array().map(f32::to_bits))
-            .collect::<Vec<_>>()
-    };
     let mut pulled = 0.0;
     for k in 0..600u32 {
         let input = StepInput {
@@ -589,16 +588,7 @@ fn a_worlds_rod_scratch_carries_nothing_between_held_stiff_and_free_strands() {
                     "grab force, step {k}"
                 );
             }
-            assert_eq!(
-                bits(together.strands()[s].positions()),
-                bits(world.strands()[0].positions()),
-                "strand {s}, step {k}"
-            );
-            assert_eq!(
-                together.strands()[s].state.theta.map(f32::to_bits),
-                world.strands()[0].state.theta.map(f32::to_bits),
-                "strand {s}, step {k}"
-            );
+            assert_same_strand_bits(&together, world, s, k);
         }
     }
     // The grab held the strand throughout, and pulled it.

@@ -91,12 +91,12 @@ pub fn step_strand<M: Math, const N: usize>(
 
 /// Scratch space for [`step_strand`]: the strand's last good state, the frames' buffer, the
 /// substeps' forces and motion ([`IntegrationSpace`]), and the projections' and the implicit
-/// step's workspaces ([`RodProjection`]). A
-/// [`crate::World`] keeps one, inside `hairsim_init`'s buffer; `step_strands` makes one for all
-/// the strands of a call. Nothing in it carries from one strand or step to the next (each
-/// strand's step sets what it reads): made for each strand, its zeros and copies were 5 % of
-/// the Cortex-M4F's rod step (`firmware/profile.py`), and on the stack its kilobytes were
-/// most of a step's stack (10 KB at 16 nodes).
+/// step's workspaces ([`RodProjection`]). A [`crate::World`] keeps one, inside
+/// `hairsim_init`'s buffer, copied from a constant (`StepScratch::build_rod`); `step_strands`
+/// makes one for all the strands of a call. Nothing in it carries from one strand or step to
+/// the next (each strand's step sets what it reads): made for each strand, its zeros and
+/// copies would be 5 % of the Cortex-M4F's rod step (`firmware/profile.py`), and on the stack
+/// its kilobytes would be most of a step's stack (10 KB at 16 nodes).
 pub struct RodScratch<M: Math, const N: usize> {
     pub(super) last_good: StrandState<N>,
     pub(super) frames: RodFrames<M, N>,
@@ -123,9 +123,7 @@ impl<const N: usize> IntegrationSpace<N> {
 }
 
 impl<M: Math, const N: usize> RodScratch<M, N> {
-    /// Before its first use (always inlined, so that a world built in place builds it in
-    /// place).
-    #[inline(always)]
+    /// Before its first use.
     #[must_use]
     pub const fn new() -> Self {
         RodScratch {
