@@ -122,6 +122,19 @@ pub fn is_finite(v: Vec3) -> bool {
     v.x.is_finite() && v.y.is_finite() && v.z.is_finite()
 }
 
+/// `f32::max` by compares: the larger of `a` and `b`, the other where one is NaN, `a` on a
+/// tie. The same value as `a.max(b)` but for the sign of a zero, by two compares where
+/// `f32::max` is a call to `fmaxf` on the Cortex-M4F, which has no `VMAXNM`.
+#[inline(always)]
+#[must_use]
+pub fn max(a: Real, b: Real) -> Real {
+    if b > a || a.is_nan() {
+        b
+    } else {
+        a
+    }
+}
+
 /// `v / |v|` as `v · (1/|v|)`, with the backend's square root.
 #[inline]
 #[must_use]

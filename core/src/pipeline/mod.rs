@@ -401,7 +401,7 @@ fn flag_inactive(params: &Params, colliders: &[Collider], grabs: &[Grab], report
 /// segment stretched past [`STRETCH_LIMIT`] raises [`Flags::STRETCHED`].
 pub fn finish(grabs: &mut [Grab], report: &mut StepReport) {
     apply_slips(grabs, report);
-    if report.max_stretch.max(report.max_contact_stretch) > STRETCH_LIMIT {
+    if crate::math::max(report.max_stretch, report.max_contact_stretch) > STRETCH_LIMIT {
         report.flags.insert(Flags::STRETCHED);
     }
 }

@@ -454,7 +454,7 @@ impl<const N: usize> ContactMemory<N> {
 #[inline(always)]
 #[must_use]
 pub fn magnitude(p: Vec3) -> Real {
-    p.x.abs().max(p.y.abs()).max(p.z.abs())
+    crate::math::max(crate::math::max(p.x.abs(), p.y.abs()), p.z.abs())
 }
 
 /// What f32 positions can resolve of a constraint's value. Each coordinate is rounded to
@@ -469,7 +469,7 @@ pub fn magnitude(p: Vec3) -> Real {
 #[must_use]
 pub fn resolution_floor(is_contact: bool, a: Vec3, b: Vec3, length_scale: Real) -> Real {
     let eps = Real::EPSILON;
-    let m = magnitude(a).max(magnitude(b));
+    let m = crate::math::max(magnitude(a), magnitude(b));
     if is_contact {
         4.0 * eps * (m + length_scale)
     } else {
@@ -729,8 +729,8 @@ impl<const N: usize, const S: usize> Rows<N, S> {
     /// before it: into the residual, the deepest penetration and the convergence test.
     #[inline(always)]
     fn meet_contact(&mut self, depth: Real, scale: Real, tolerance: Real, shape: &Shape, p: Vec3) {
-        self.residual = self.residual.max(depth / scale);
-        self.max_depth = self.max_depth.max(depth);
+        self.residual = crate::math::max(self.residual, depth / scale);
+        self.max_depth = crate::math::max(self.max_depth, depth);
         if self.converged && depth > tolerance * scale {
             let reach = match *shape {
                 Shape::Sphere { radius, .. } | Shape::Capsule { radius, .. } => radius,

@@ -21,7 +21,7 @@ use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Grab};
 use crate::lane::{self, Aligned, Alignment, Lane as _, Natural, Wide, WideMask, V3};
-use crate::math::{Math, Real, Vec3};
+use crate::math::{self, Math, Real, Vec3};
 use crate::params::Mode;
 use crate::precision::Vector;
 use crate::report::{Stage, StepReport};
@@ -360,13 +360,15 @@ impl<const N: usize, const W: usize, A: Alignment> BlockProjection<N, W, A> {
             *x = lanes.lane(lane);
         }
         report.ran(Stage::Velocity);
-        for (v, change) in state.velocity.iter_mut().zip(&self.step).take(n).skip(2) {
+        let free = 2.min(n)..n;
+        let velocity = state.velocity.get_mut(free.clone()).unwrap_or(&mut []);
+        for (v, change) in velocity.iter_mut().zip(self.step.get(free).unwrap_or(&[])) {
             *v += change.lane(lane);
         }
         record_outcome(ctx, &book.outcome, &findings, n, report);
-        report.max_stretch = report.max_stretch.max(concluded.free_stretch[lane]);
+        report.max_stretch = math::max(report.max_stretch, concluded.free_stretch[lane]);
         let at_contacts = concluded.contact_stretch[lane];
-        report.max_contact_stretch = report.max_contact_stretch.max(at_contacts);
+        report.max_contact_stretch = math::max(report.max_contact_stretch, at_contacts);
         Outcome {
             root_pull,
             collider_felt: felt_by_colliders(ctx, &book.collider_push),

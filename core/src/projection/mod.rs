@@ -40,7 +40,7 @@ use crate::context::StepContext;
 use crate::effects::Effect;
 use crate::grab::{grabbed_nodes, Coupling, Grab, GrabbedNodes, MAX_GRABS};
 use crate::lane::{Lane, V3};
-use crate::math::{Math, Real, Vec3};
+use crate::math::{self, Math, Real, Vec3};
 use crate::params::Mode;
 use crate::report::{Flags, Stage, StepReport};
 use crate::strand::Strand;
@@ -329,17 +329,20 @@ fn layout_in_mode(ctx: &StepContext, shape_count: usize, mode: Mode) -> Layout {
 #[inline(always)]
 fn free_nodes<const N: usize>(strand: &Strand<N>, n: usize) -> Nodes<N> {
     let mut inverse_mass = [0.0; N];
-    for (i, (w, &rest)) in inverse_mass
+    // Nodes 0 and 1 are held (0 from the fill); over slices of the rest, not `enumerate`,
+    // `take` and a test of the index.
+    let free = 2.min(n)..n;
+    let rest = strand.rest.inverse_mass.get(free.clone()).unwrap_or(&[]);
+    for (w, &rest) in inverse_mass
+        .get_mut(free)
+        .unwrap_or(&mut [])
         .iter_mut()
-        .zip(strand.rest.inverse_mass.iter())
-        .enumerate()
-        .take(n)
+        .zip(rest)
     {
-        *w = if i >= 2 && rest > 0.0 && rest.is_finite() {
-            rest
-        } else {
-            0.0
-        };
+        // `rest < ∞` as `is_finite` for a positive value (NaN fails `rest > 0`).
+        if rest > 0.0 && rest < Real::INFINITY {
+            *w = rest;
+        }
     }
     Nodes {
         inverse_mass,
@@ -364,6 +367,7 @@ fn trust_radius<const N: usize>(strand: &Strand<N>, n: usize) -> Real {
 /// positions it came in with — finite, unprojected — and the outcome says the constraints are
 /// not met, with the inextensibility residual of those positions and one more dropped row.
 /// "Overflowed" includes a finite move so large that the velocity update `Δx/h` would not be.
+#[allow(clippy::eq_op)] // c − c is the point: 0 for finite c, NaN for ±∞ and NaN.
 fn keep_finite<const N: usize>(
     strand: &mut Strand<N>,
     predicted: &[Vec3; N],
@@ -372,12 +376,15 @@ fn keep_finite<const N: usize>(
     outcome: &mut Outcome,
 ) {
     let position = &mut strand.state.position;
-    let finite = position
-        .iter()
-        .zip(predicted.iter())
-        .take(n)
-        .all(|(x, p)| crate::math::is_finite((*x - *p) * inv_dt));
-    if finite {
+    // One sum of `c − c` over every component `c` of every `(x − x̃)/h`, no branch per value
+    // (as `Strand::is_finite`): 0 while all are finite, NaN as soon as one is not.
+    let mut poison: Real = 0.0;
+    let moved = position.get(..n).unwrap_or(&[]).iter();
+    for (&x, &p) in moved.zip(predicted.get(..n).unwrap_or(&[])) {
+        let v = (x - p) * inv_dt;
+        poison += (v.x - v.x) + (v.y - v.y) + (v.z - v.z);
+    }
+    if poison == 0.0 {
         return;
     }
     *position = *predicted;
@@ -392,7 +399,7 @@ fn keep_finite<const N: usize>(
             residual = relative;
         }
     }
-    outcome.residual = outcome.residual.max(residual);
+    outcome.residual = math::max(outcome.residual, residual);
     if !outcome.residual.is_finite() {
         outcome.residual = Real::MAX;
     }
@@ -731,7 +738,7 @@ impl NearColliders {
                 }
             }
         }
-        self.rounding = 1.0e-5 * magnitude(low).max(magnitude(high)) + 1.0e-6;
+        self.rounding = 1.0e-5 * math::max(magnitude(low), magnitude(high)) + 1.0e-6;
         self.low = low;
         self.high = high;
         self.grown = 0.0;
@@ -817,7 +824,7 @@ fn may_touch_box(shape: &Shape, low: Vec3, high: Vec3) -> bool {
             distance2 <= reach * reach || distance2.is_nan()
         }
         Shape::Capsule { a, b, radius } => {
-            let reach = radius + 1.0e-5 * (magnitude(a).max(magnitude(b)) + radius);
+            let reach = radius + 1.0e-5 * (math::max(magnitude(a), magnitude(b)) + radius);
             let (a_low, a_high) = (a.min(b) - reach, a.max(b) + reach);
             !(a_low.x > high.x
                 || a_low.y > high.y
@@ -852,48 +859,12 @@ fn solve_and_move<M: Math, const N: usize>(
     let n = work.nodes.count.min(N);
     let count = work.rows.count.min(N);
     let dropped = solve(work, n, count)?;
-    let rows = work.rows.rows();
     let multipliers = work.multipliers.get(..count)?;
     if !multipliers.iter().all(|l| l.is_finite()) {
         return None;
     }
-    // Δx: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact), contacts
-    // by −d_i. Gathered per node from its two segments (segment i − 1 first, as the rows are in
-    // segment order) and its contacts, with the longest move for the trust region below in
-    // the same pass. A node without collision rows has `kept = 0` (see `Rows::contacts`).
-    let mut any_contact = false;
-    let mut longest2: Real = 0.0;
-    let segment_row = &work.rows.segment_row;
-    let nodes = work
-        .step
-        .iter_mut()
-        .zip(work.nodes.inverse_mass.iter())
-        .zip(work.rows.contacts.iter())
-        .enumerate()
-        .take(n);
-    for (i, ((dx, &w), contacts)) in nodes {
-        let mut delta = Vec3::ZERO;
-        if w > 0.0 {
-            for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
-                let r = segment_row
-                    .get(segment)
-                    .map_or(usize::MAX, |&r| usize::from(r));
-                if let (Some(row), Some(&lambda)) = (rows.get(r), multipliers.get(r)) {
-                    delta -= row.projected[block] * (w * lambda);
-                }
-            }
-        }
-        if contacts.kept > 0 {
-            delta -= contacts.displacement;
-            any_contact = true;
-        }
-        let d2 = delta.dot(delta);
-        // Not `max`, which would drop a NaN.
-        if d2.is_nan() || d2 > longest2 {
-            longest2 = d2;
-        }
-        *dx = delta;
-    }
+    let (longest2, any_contact) =
+        gather_moves(&mut work.step, &work.nodes, &work.rows, multipliers);
     if !longest2.is_finite() {
         return None;
     }
@@ -913,6 +884,60 @@ fn solve_and_move<M: Math, const N: usize>(
         push_on_colliders_alone(work, count, n, scale);
     }
     Some((dropped, longest2))
+}
+
+/// Δx into `step`: segments move node i by −w_i (I − P_i) ∇_iC δλ (P_i = 0 without contact),
+/// contacts by −d_i. Gathered per node from its two segments (segment i − 1 first, as the rows
+/// are in segment order) and its contacts, with the longest move (squared, for the trust
+/// region) in the same pass. A node without collision rows has `kept = 0` (see
+/// `Rows::contacts`). Returns the longest move and whether some node had a contact.
+#[inline(always)]
+fn gather_moves<const N: usize>(
+    step: &mut [Vec3; N],
+    nodes: &Nodes<N>,
+    rows: &Rows<N>,
+    multipliers: &[Real],
+) -> (Real, bool) {
+    let mut any_contact = false;
+    let mut longest2: Real = 0.0;
+    // Segment `i`'s row and multiplier, if it has a row.
+    let row_of = |i: usize| {
+        let r = rows
+            .segment_row
+            .get(i)
+            .map_or(usize::MAX, |&r| usize::from(r));
+        rows.rows().get(r).zip(multipliers.get(r).copied())
+    };
+    let step = step.get_mut(..nodes.count.min(N)).unwrap_or(&mut []);
+    let free = step
+        .iter_mut()
+        .zip(nodes.inverse_mass.iter())
+        .zip(rows.contacts.iter());
+    // Node `i` takes segment `i − 1`'s row, which node `i − 1` looked up, then segment `i`'s.
+    let mut previous = None;
+    for (i, ((dx, &w), contacts)) in free.enumerate() {
+        let next = row_of(i);
+        let mut delta = Vec3::ZERO;
+        if w > 0.0 {
+            for (segment, block) in [(previous, 1), (next, 0)] {
+                if let Some((row, lambda)) = segment {
+                    delta -= row.projected[block] * (w * lambda);
+                }
+            }
+        }
+        previous = next;
+        if contacts.kept > 0 {
+            delta -= contacts.displacement;
+            any_contact = true;
+        }
+        let d2 = delta.dot(delta);
+        // Not `max`, which would drop a NaN.
+        if d2.is_nan() || d2 > longest2 {
+            longest2 = d2;
+        }
+        *dx = delta;
+    }
+    (longest2, any_contact)
 }
 
 /// The scale of an iteration's moves, the longest `√longest2` long, within the trust radius
@@ -971,17 +996,20 @@ fn pull_on_grabs<const N: usize>(
     count: usize,
     scale: Real,
 ) {
-    let rows = if held.is_empty() {
-        &[]
-    } else {
-        work.rows.rows()
-    };
+    let (rows, segment_row) = (work.rows.rows(), &work.rows.segment_row);
     let multipliers = work.multipliers.get(..count).unwrap_or(&[]);
-    for (row, &lambda) in rows.iter().zip(multipliers.iter()) {
-        for (&node, &gradient) in row.nodes.iter().zip(row.gradients().iter()) {
-            let i = usize::from(node);
-            if let Some(pull) = held.grab_of(i).and_then(|g| work.grab_pull.get_mut(g)) {
-                *pull -= gradient * (lambda * scale);
+    // A held node `i` is in two rows at most, segment `i − 1`'s (as its second node) then
+    // segment `i`'s (its first), in row order: those two, not every row's nodes searched.
+    for (g, i) in held.iter() {
+        let Some(pull) = work.grab_pull.get_mut(g) else {
+            continue;
+        };
+        for (segment, block) in [(i.wrapping_sub(1), 1), (i, 0)] {
+            let r = segment_row
+                .get(segment)
+                .map_or(usize::MAX, |&r| usize::from(r));
+            if let (Some(row), Some(&lambda)) = (rows.get(r), multipliers.get(r)) {
+                *pull -= row.gradients()[block] * (lambda * scale);
             }
         }
     }
@@ -1120,12 +1148,12 @@ fn segment_pull_on_node<const N: usize>(rows: &Rows<N>, multipliers: &[Real], i:
 fn update_velocities<const N: usize>(strand: &mut Strand<N>, predicted: &[Vec3; N], inv_dt: Real) {
     let n = strand.rest.nodes.min(N);
     let state = &mut strand.state;
-    let nodes = state
-        .velocity
-        .iter_mut()
-        .zip(state.position.iter())
-        .zip(predicted.iter());
-    for ((v, &x_proj), &x_pred) in nodes.take(n).skip(2) {
+    // Slices of the free nodes, not `take(n).skip(2)` (`dftl::strand_momentum` says why).
+    let free = 2.min(n)..n;
+    let velocity = state.velocity.get_mut(free.clone()).unwrap_or(&mut []);
+    let position = state.position.get(free.clone()).unwrap_or(&[]);
+    let predicted = predicted.get(free).unwrap_or(&[]);
+    for ((v, &x_proj), &x_pred) in velocity.iter_mut().zip(position).zip(predicted) {
         let delta_x = x_proj - x_pred;
         *v += delta_x * inv_dt;
     }
@@ -1158,9 +1186,9 @@ fn record<M: Math, const N: usize>(
         let rest = strand.rest.segment_length[j];
         let stretch = segment_stretch::<M, Real>((x[j + 1] - x[j]).into(), rest);
         if work.touched[j] != 0 || work.touched[j + 1] != 0 {
-            report.max_contact_stretch = report.max_contact_stretch.max(stretch);
+            report.max_contact_stretch = math::max(report.max_contact_stretch, stretch);
         } else {
-            report.max_stretch = report.max_stretch.max(stretch);
+            report.max_stretch = math::max(report.max_stretch, stretch);
         }
     }
 }
@@ -1199,7 +1227,7 @@ fn record_outcome<const N: usize>(
     if work.truncated {
         report.flags.insert(Flags::CONTACTS_TRUNCATED);
     }
-    report.max_penetration = report.max_penetration.max(work.max_depth);
+    report.max_penetration = math::max(report.max_penetration, work.max_depth);
     report.contacts += work.touched.iter().take(n).filter(|&&t| t != 0).count() as u32;
     let inv_h2 = ctx.inv_dt * ctx.inv_dt;
     for (force, push) in report
