@@ -149,6 +149,13 @@ fn relative_stretch<M: Math, T: Lane>(strain: T) -> T {
 /// at one end or the other.
 #[inline(always)]
 fn largest_stretch<M: Math, T: Lane>(up: T, down: T) -> T {
+    // Both extremes still at their start, 0 (no segment of the kind, as the contact ones of a
+    // strand without contact: the extremes are maxima from 0 and never NaN): δ is 0 at both
+    // ends, `+0` as the formula gives it, without its two square roots and divisions.
+    let zero = T::splat(0.0);
+    if !T::any(zero.lt(up)) && !T::any(zero.lt(down)) {
+        return zero;
+    }
     relative_stretch::<M, T>(up).max(-relative_stretch::<M, T>(-down))
 }
 

@@ -27,6 +27,9 @@ pub struct Setup {
     pub drag_coefficient: Real,
     /// Whether the shape constraints (and the frames they need) run.
     pub shape: bool,
+    /// Whether the global shape constraint pulls (`s_g` > 0; with `shape`): a held strand's
+    /// pass runs without it, and a node skips a correction that would add 0.
+    pub global_shape: bool,
     /// Whether follow-the-leader inextensibility runs.
     pub inextensibility: bool,
     /// Whether any collider is in use.
@@ -62,6 +65,7 @@ impl Setup {
             drag: ctx.gates.drag,
             drag_coefficient: ctx.params.drag,
             shape: ctx.gates.shape,
+            global_shape: ctx.dftl.global_shape != 0.0,
             inextensibility: ctx.gates.inextensibility,
             collisions: ctx.gates.colliders,
             coefficients: ctx.dftl,

@@ -214,6 +214,7 @@ fn step_held_strand<M: Math, const N: usize>(
     // step on a strand held 14 cm short of its rest: the projection then trembles).
     let unprojected = Setup {
         inextensibility: false,
+        global_shape: false,
         damping_over_dt: 0.0,
         coefficients: DftlCoefficients {
             global_shape: 0.0,
@@ -467,7 +468,9 @@ pub fn advance<M: Math, T: Lane>(
     // (`dftl::velocity` says why).
     let mut local = V3::zero();
     if setup.shape {
-        x = x + shape::global_correction(setup, node.rest_position, node.root_distance, x);
+        if setup.global_shape {
+            x = x + shape::global_correction(setup, node.rest_position, node.root_distance, x);
+        }
         let (previous, tangent, normal) = (chain.position, chain.tangent, chain.normal);
         let rest = (node.local_rest, node.root_distance);
         local = shape::local_correction(setup, previous, tangent, normal, rest.0, rest.1, x);
