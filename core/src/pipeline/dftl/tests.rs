@@ -152,8 +152,9 @@ fn world(effects: &[Effect]) -> World<5, 16, Libm> {
 }
 
 /// The report's figures both paths must agree on, as bits.
-fn bits(r: &StepReport) -> [u32; 9] {
+fn bits(r: &StepReport) -> [u32; 12] {
     let [a, b] = [r.collider_forces[0], r.collider_forces[1]];
+    let head = r.head_force;
     [
         r.max_stretch,
         r.max_contact_stretch,
@@ -164,6 +165,9 @@ fn bits(r: &StepReport) -> [u32; 9] {
         b.x,
         b.y,
         b.z,
+        head.x,
+        head.y,
+        head.z,
     ]
     .map(Real::to_bits)
 }
