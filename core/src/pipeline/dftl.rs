@@ -678,7 +678,8 @@ fn block_pass<
     let mut previous_contact = Wide::<W>::mask(false);
     let mut pending = Pending::start();
     // The head force's sum, kept apart: carried through the node loop beside the chain, its
-    // three vectors of lanes spilled the loop (8-lane blocks of DFTL + shape ran 30 % slower).
+    // three vectors of lanes spilled the loop (8-lane blocks of DFTL + shape ran a quarter
+    // slower).
     let mut kicked = [V3::zero(); N];
     // Nodes every lane has: there every lane is active and every selection below is a
     // constant (the same bits as the masked form, without its blends).
@@ -775,8 +776,7 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
 /// Lines 24–26 once node `k` of every lane is advanced (or, past a lane's end, with zero
 /// corrections), as the per-strand path's `hand_on`: node `k − 1`'s final position `x_star`
 /// is stored where `moving` (it is free), and node `k − 2`'s velocity where `finishing`.
-/// Returns the [`component_sum`] of the velocities stored, 0 in the
-/// other lanes (whose
+/// Returns the [`component_sum`] of the velocities stored, 0 in the other lanes (whose
 /// velocities the last guard saw finite): each lane's total adds its strand's per-strand terms
 /// in the same order, and zeros, which change no verdict. Constant masks fold away.
 #[inline(always)]
