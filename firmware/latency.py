@@ -3,7 +3,7 @@
 into instructions and a Cortex-M4F cycle estimate, and names the largest rod and DFTL scenes
 that fit half of a 1 ms tick on a 168 MHz part. For the `haptic-dftl` scene (a device holding a
 DFTL strand through a coupling) it fails unless its violent maximum fits half a tick at
-168 MHz and is at most 1.2x its calm median (docs/study/floors.md section 6: the model's
+168 MHz and is at most 1.2x its calm median (docs/study/floors.md section 5: the model's
 margin, and what the scene's executed mix of instructions gives).
 
 Model (stated, not measured on silicon): QEMU's icount makes each instruction 1 ns and SysTick

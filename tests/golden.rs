@@ -68,7 +68,7 @@ const TABLE: &[Golden] = &[
     g("head-3", "rod", "hair-optimised", 300, 0xbf99d3eac0e15afb),
     g("head-3", "rod", "newton", 300, 0xeae630b081b6aa8b),
     g("head-3", "dftl", "-", 300, 0xedb1905ba959a014),
-    g("mannequin-a", "dftl", "-", 4, 0x7cb70ff3261d6dfe),
+    g("mannequin-a", "dftl", "-", 4, 0x0de2a68dda3d6b63),
     g("mannequin-a", "rod", "hair-optimised", 4, 0xc9ebffa215f17571),
     g("mannequin-a", "rod", "newton", 4, 0xc9ebffa215f17571),
     g("mannequin-b", "dftl", "-", 100, 0x59e993feabcecd62),

@@ -8,7 +8,8 @@
 //! as the quaternion product does, but as a Rodrigues rotation of one vector it needs one
 //! division and no square root, where the quaternion product needs a renormalisation (a
 //! square root and a division per node). The step's tangent comes from the follow-the-leader
-//! projection, which already has `1/|e|`, so a frame costs no square root at all.
+//! projection, which already has `1/|e|`, so a frame costs no square root where no collider
+//! moved the node.
 
 use crate::lane::{Lane, V3};
 use crate::math::{self, Math, Quat, Vec3};
@@ -49,27 +50,46 @@ pub fn transport<T: Lane>(tangent: V3<T>, normal: V3<T>, t: V3<T>) -> V3<T> {
 }
 
 /// SB15 Algorithm 1 line 21: the frame of the final node `i` carried from node `i − 1`'s
-/// (`chain`). Its tangent is `tangent` where `known` (follow-the-leader's, when no collider
-/// moved the node), else the unit edge of `segment` (`chain`'s tangent for a zero edge); its
-/// normal is [`transport`]ed. Returns `(t_i, n_i)`.
+/// (`chain`). Its tangent is `tangent` where `known` (follow-the-leader's, before a collider
+/// moved the node), else the unit edge of `segment` (`chain`'s tangent for a zero edge). Where
+/// a collider pushed the node by `push` (`contact`), the tangent turns from
+/// follow-the-leader's towards the pushed edge by the push's share of the rest length
+/// `length`, all the way from a push of a whole segment on: a push of a few per cent of a
+/// segment, a node resting on the head, supports the node without turning the rest shape
+/// the nodes after it follow, while a strand whose rest shape runs into the head follows its
+/// surface. The normal is [`transport`]ed. Returns `(t_i, n_i)`.
 #[inline(always)]
 #[must_use]
 pub fn carry<M: Math, T: Lane>(
     chain: &Chain<T>,
     segment: &Segment<T>,
-    tangent: V3<T>,
-    known: T::Mask,
+    (tangent, known): (V3<T>, T::Mask),
+    (push, contact, length): (V3<T>, T::Mask, T),
 ) -> (V3<T>, V3<T>) {
-    let t = if T::all(known) {
+    let t = if T::all(known) && !T::any(contact) {
         tangent
     } else {
-        let length = segment.squared_length.sqrt::<M>();
+        let edge_length = segment.squared_length.sqrt::<M>();
         let exact = V3::select(
-            T::splat(0.0).lt(length),
-            segment.edge.scale(T::splat(1.0) / length),
+            T::splat(0.0).lt(edge_length),
+            segment.edge.scale(T::splat(1.0) / edge_length),
             chain.tangent,
         );
-        V3::select(known, tangent, exact)
+        let t = if T::any(contact) {
+            let share = push.dot(push).sqrt::<M>() / length;
+            let share = T::select(T::splat(1.0).lt(share), T::splat(1.0), share);
+            let turned = tangent + (exact - tangent).scale(share);
+            let turned_length = turned.dot(turned).sqrt::<M>();
+            let turned = V3::select(
+                T::splat(0.0).lt(turned_length),
+                turned.scale(T::splat(1.0) / turned_length),
+                exact,
+            );
+            V3::select(contact, turned, tangent)
+        } else {
+            tangent
+        };
+        V3::select(known, t, exact)
     };
     (t, transport(chain.tangent, chain.normal, t))
 }
@@ -84,7 +104,7 @@ pub fn rotate<T: Lane>(tangent: V3<T>, normal: V3<T>, v: V3<T>) -> V3<T> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::{Libm, Math};
+    use crate::math::{Libm, Math, Real};
 
     /// Rodrigues' rotation about `t_{i−1} × t_i` by the angle between the tangents, the
     /// textbook form of the minimal rotation, in f64.
@@ -140,5 +160,46 @@ mod tests {
             "normal length {}",
             n.length()
         );
+    }
+
+    /// The frame of a node 1 cm from the one before, follow-the-leader's tangent along +x,
+    /// pushed along +y by `push`.
+    fn carried_after(push: f32, contact: bool) -> Vec3 {
+        let chain = Chain {
+            position: V3::<Real>::from(Vec3::ZERO),
+            tangent: Vec3::X.into(),
+            normal: Vec3::Y.into(),
+        };
+        let push = Vec3::new(0.0, push, 0.0);
+        let x = Vec3::new(0.01, 0.0, 0.0) + push;
+        let segment = Segment {
+            edge: x.into(),
+            squared_length: x.length_squared(),
+        };
+        let (t, _) = carry::<Libm, Real>(
+            &chain,
+            &segment,
+            (Vec3::X.into(), true),
+            (push.into(), contact, 0.01),
+        );
+        t.into()
+    }
+
+    #[test]
+    fn a_push_turns_the_frame_by_its_share_of_a_segment() {
+        // No contact: follow-the-leader's tangent, whatever the segment.
+        assert_eq!(carried_after(0.004, false), Vec3::X);
+        // A push of a whole segment or more: along the pushed segment.
+        let whole = carried_after(0.01, true);
+        let edge = Vec3::new(0.01, 0.01, 0.0).normalize();
+        assert!((whole - edge).length() < 1e-6, "{whole}");
+        // A push of a tenth of a segment: a tenth of the way towards the pushed edge (which is
+        // 0.0997 rad off), a unit vector.
+        let tenth = carried_after(0.001, true);
+        let turned =
+            (Vec3::X + (Vec3::new(0.01, 0.001, 0.0).normalize() - Vec3::X) * 0.1).normalize();
+        assert!((tenth - turned).length() < 1e-6, "{tenth}");
+        assert!((tenth.length() - 1.0).abs() < 1e-6);
+        assert!(tenth.y > 0.0 && tenth.y < 0.02, "{tenth}");
     }
 }

@@ -486,7 +486,7 @@ pub fn advance<M: Math, T: Lane>(
         (x, tangent, tangent_known) = (projected, t, T::mask(true));
     }
     // Line 20: collisions, each collider in turn (not part of the correction).
-    let mut contact = T::mask(false);
+    let (mut contact, followed) = (T::mask(false), x);
     if setup.collisions {
         let node_mass = (node.active, node.mass);
         (x, contact) =
@@ -500,10 +500,12 @@ pub fn advance<M: Math, T: Lane>(
         node,
         contact | previous_contact,
     );
-    // Line 21: the frame, carried only when the shape constraints need it. The tangent from
-    // follow-the-leader holds unless a collider moved the node (or there was no projection).
+    // Line 21: the frame, carried only when the shape constraints need it, along
+    // follow-the-leader's tangent (the segment's without the projection), turned towards the
+    // pushed segment by the push's share of a segment (`frame::carry` says why).
     let (tangent, normal) = if setup.shape {
-        frame::carry::<M, T>(chain, &segment, tangent, tangent_known & !contact)
+        let push = (x - followed, contact, node.segment_length);
+        frame::carry::<M, T>(chain, &segment, (tangent, tangent_known), push)
     } else {
         (chain.tangent, chain.normal)
     };
