@@ -18,5 +18,8 @@ pub fn cpu_seconds() -> f64 {
     (ticks(11) + ticks(12)) / 100.0
 }
 
+/// Sánchez-Banderas 2015 Table 1's scenes (the `sph` bench and the SPH comparison example).
+pub mod table1;
+
 /// Kmoch 2009 Table 3's scene (the `rod_projection` bench and its instruction-count example).
 pub mod table3;

@@ -22,9 +22,9 @@
 
 use std::time::{Duration, Instant};
 
-use hairsim::scene::{HairSpec, Prepared, Scene};
 use hairsim::sim::{scene_inputs, Sim, StepInputs};
 use hairsim_benches::cpu_seconds;
+use hairsim_benches::table1::{scene, Size, COLUMNS, SIZES};
 use hairsim_core::DefaultMath;
 
 /// Seconds of the scene before timing.
@@ -34,67 +34,6 @@ const STEPS: u64 = 300;
 
 /// Times the SPH stage runs on one state with `stage`.
 const STAGE_REPEATS: usize = 15;
-
-/// A Table 1 size: name, strands, nodes per strand (vertices = strands × nodes; the paper's
-/// count in the comment where it is not a multiple).
-struct Size {
-    name: &'static str,
-    strands: u32,
-    nodes: u32,
-}
-
-const SIZES: &[Size] = &[
-    // 349,232 in the paper: 23.3 a strand.
-    Size {
-        name: "mannequin-a",
-        strands: 15_000,
-        nodes: 23,
-    },
-    Size {
-        name: "mannequin-b",
-        strands: 500,
-        nodes: 16,
-    },
-    // 32,041 in the paper: 9.5 a strand.
-    Size {
-        name: "horse-louis",
-        strands: 3_358,
-        nodes: 10,
-    },
-    Size {
-        name: "bunny",
-        strands: 2_902,
-        nodes: 12,
-    },
-    // 5,710 in the paper: 11.5 a strand.
-    Size {
-        name: "hectroll",
-        strands: 496,
-        nodes: 12,
-    },
-];
-
-/// Table 1's columns.
-const COLUMNS: &[&str] = &["dftl", "dftl+shape", "dftl+shape+hair-hair"];
-
-/// The mannequin scene (DFTL + shape + hair–hair) with `size`'s strands and nodes, the effects
-/// of `column`, at a step of `dt` (the scene's own when `None`).
-fn scene(size: &Size, column: &str, dt: Option<f32>) -> Prepared {
-    let mut scene: Scene = (hairsim::builtin::find("mannequin-a").unwrap().scene)();
-    if let Some(dt) = dt {
-        scene.dt = dt;
-    }
-    if let Some(HairSpec::Scalp(scalp)) = &mut scene.hair {
-        scalp.leaders = size.strands;
-        scalp.nodes = size.nodes;
-    }
-    match column {
-        "dftl" => scene.effects.retain(|e| e != "shape" && e != "hair-hair"),
-        "dftl+shape" => scene.effects.retain(|e| e != "hair-hair"),
-        _ => {}
-    }
-    scene.prepare().unwrap()
-}
 
 /// How a run goes: the step (the scene's own when `None`), steps of warm-up and timed.
 #[derive(Clone, Copy)]
