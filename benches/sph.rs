@@ -17,8 +17,9 @@
 //! project's rate) than their own 1/60 s. With `stage`, the SPH stage alone on the picked sizes (after the
 //! warm-up, its accelerations computed again and again on one state, on one and two threads:
 //! the fastest of `STAGE_REPEATS` per phase — the least disturbed by other processes — and the
-//! CPU time of all of them). Under
-//! `cargo test --benches` each configuration of the two smallest sizes runs two steps.
+//! CPU time of all of them). With `moves`, the share of nodes that move more than `h / 2`, `h`
+//! and `2 h` in one step after the warm-up, in the head's frame. Under `cargo test --benches`
+//! each configuration of the two smallest sizes runs two steps.
 
 use std::time::{Duration, Instant};
 
@@ -158,6 +159,53 @@ fn stage<const N: usize>(size: &Size, warm_up: u64, repeats: usize) {
     }
 }
 
+/// How far `size`'s nodes move in one step in the head's frame, after the warm-up: the share
+/// moving more than `h / 2`, `h` and `2 h`. A list kept with a skin lasts a step only while no
+/// node moves half its skin: the share says how much of the search any skin, or an
+/// incremental rebuild of the nodes that moved, could save at the scene's step.
+fn moves<const N: usize>(size: &Size, dt: Option<f32>, warm_up: u64) {
+    let prepared = scene(size, "dftl+shape+hair-hair", dt);
+    let mut sim = Sim::<N, DefaultMath>::new(&prepared, 2).unwrap();
+    let h = sim.sph.as_ref().unwrap().params().smoothing_length;
+    let positions = |sim: &Sim<N, DefaultMath>| -> Vec<hairsim_core::Vec3> {
+        let (turn, at) = (sim.head.rotation.inverse(), sim.head.position);
+        sim.strands
+            .iter()
+            .flat_map(|s| {
+                s.state.position[..s.nodes()]
+                    .iter()
+                    .map(move |&x| turn * (x - at))
+            })
+            .collect()
+    };
+    sim.in_pool(|sim| {
+        for k in 0..warm_up {
+            sim.step(&scene_inputs::<DefaultMath>(&prepared, k));
+        }
+    });
+    let before = positions(&sim);
+    sim.in_pool(|sim| sim.step(&scene_inputs::<DefaultMath>(&prepared, warm_up)));
+    let after = positions(&sim);
+    let share = |limit: f32| {
+        let far = before
+            .iter()
+            .zip(&after)
+            .filter(|(a, b)| a.distance(**b) > limit)
+            .count();
+        100.0 * far as f64 / before.len().max(1) as f64
+    };
+    println!(
+        "{:<12} {:>8} vertices, dt {:.4} s: nodes moving more than h/2, h, 2h in a step in the head's frame: {:.1} %, {:.1} %, {:.1} % (h {} mm)",
+        size.name,
+        after.len(),
+        prepared.params.dt,
+        share(h / 2.0),
+        share(h),
+        share(2.0 * h),
+        h * 1e3,
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.iter().any(|a| a == "--list") {
@@ -188,6 +236,13 @@ fn main() {
             named.is_empty() || named.iter().any(|f| f.as_str() == name)
         };
         if !picked(size.name, &SIZES.iter().map(|s| s.name).collect::<Vec<_>>()) {
+            continue;
+        }
+        if filter.iter().any(|f| f.as_str() == "moves") {
+            match size.nodes {
+                0..=16 => moves::<16>(size, dt, warm_up),
+                _ => moves::<32>(size, dt, warm_up),
+            }
             continue;
         }
         if filter.iter().any(|f| f.as_str() == "stage") {

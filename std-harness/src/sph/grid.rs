@@ -108,6 +108,17 @@ pub fn bucket_of(cell: [i32; 3], layout: Layout) -> u32 {
 /// Parts of the bucket range the counting sort's second pass sorts side by side.
 const PARTS: usize = 64;
 
+/// Buckets per particle. Cells a period apart share a bucket, and sparse hair (a shell around
+/// the head, whose box holds hundreds of cells per particle) fills its buckets about evenly:
+/// with one bucket a particle, the 27 buckets around a particle held about as many unrelated
+/// particles, which the search tested for nothing; eight make them eight times rarer, and a
+/// particle alone in its 27 buckets is not tested at all (`super::neighbours`).
+pub const BUCKETS_PER_PARTICLE: usize = 8;
+
+/// The most rows (of [`ROW`] buckets): 2¹⁹ buckets, as many as a scene of 262,144 to 524,288
+/// particles had with one bucket a particle; dense hair has few empty ranges to drop.
+pub const MAX_ROWS: usize = 1 << 13;
+
 /// Particles per work item of the counting sort's first and last passes (a constant of the
 /// code, never derived from the thread count).
 const SORT_CHUNK: usize = 8192;
@@ -139,14 +150,16 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// A grid for `particles` particles and cells of size `h`: about one bucket per particle
-    /// (a power of two, whole rows), so that unrelated cells are mostly apart. `extent` is
+    /// A grid for `particles` particles and cells of size `h`: about
+    /// [`BUCKETS_PER_PARTICLE`] buckets per particle, at most [`MAX_ROWS`] rows (a power of
+    /// two, whole rows), so that unrelated cells are mostly apart. `extent` is
     /// the size of the box the particles start in, m: the rows along y and the slabs along z
     /// are shared out as it is ([`Layout::fitting`]), so that the hair's cells wrap around as
     /// little as the buckets allow.
     #[must_use]
     pub fn new(particles: usize, h: f32, extent: [f32; 3]) -> Grid {
-        let rows = (particles.next_power_of_two() / ROW as usize).max(16);
+        let rows = ((particles * BUCKETS_PER_PARTICLE).next_power_of_two() / ROW as usize)
+            .clamp(16, MAX_ROWS);
         let buckets = rows * ROW as usize;
         let chunks = particles.div_ceil(SORT_CHUNK);
         Grid {

@@ -8,7 +8,8 @@
 //! ([`RowsAround`]) are computed once per run of particles in one row, and the 27 cells are read
 //! as nine ranges of three cells (more where the row wraps around) of the sorted
 //! structure-of-arrays positions, looked up once per cell (the sorted particles of a cell are
-//! consecutive). Each range is tested where it lies, four candidates at a time for
+//! consecutive), the empty ones dropped; a particle alone in its 27 cells tests nothing. Each
+//! range is tested where it lies, four candidates at a time for
 //! `r² < R²` (no square root; one packed compare on x86-64), in pieces of eight with no branch
 //! on the range's length, and the hits of many pieces are taken from one mask, a byte a piece
 //! ([`test_ranges`]). A particle itself and its own strand's near nodes are never candidates.
@@ -179,6 +180,8 @@ impl Search<'_> {
         // The cell whose 27 cells `ranges` holds, and how many: sorted particles of one cell
         // are consecutive and share them.
         let mut ranged: Option<([i32; 3], usize)> = None;
+        // Particles in those cells, the particle itself among them.
+        let mut around = 0u32;
         for (k, (start, count)) in start.iter_mut().zip(count.iter_mut()).enumerate() {
             let a = c * CHUNK + k;
             let me = self.at(a);
@@ -187,12 +190,21 @@ impl Search<'_> {
             let m = match ranged {
                 Some((of, m)) if of == cell => m,
                 _ => {
-                    let m = rows.ranges(self.grid, cell, &mut ranges);
+                    let all = rows.ranges(self.grid, cell, &mut ranges);
+                    let m;
+                    (m, around) = without_empty(&mut ranges, all);
                     ranged = Some((cell, m));
                     m
                 }
             };
             let first = list.len();
+            // Alone in its 27 cells: no candidate, and nothing to test (most particles of a
+            // scene where little touches).
+            if around <= 1 {
+                *start = first as u32;
+                *count = 0;
+                continue;
+            }
             let own = self.key.get(a).copied().unwrap_or(0);
             let (key, gap) = (self.key, self.gap);
             test_ranges(
@@ -212,6 +224,22 @@ impl Search<'_> {
             *count = (list.len() - first) as u32;
         }
     }
+}
+
+/// The first `m` of `ranges` without the empty ones, in their order (the particle's own range,
+/// never empty, stays first), without a branch on their lengths; returns how many remain and
+/// the particles they hold.
+#[inline(always)]
+fn without_empty(ranges: &mut [(u32, u32); MAX_RANGES], m: usize) -> (usize, u32) {
+    let (mut kept, mut total) = (0, 0u32);
+    for k in 0..m.min(MAX_RANGES) {
+        let (s, e) = ranges[k];
+        let length = e.saturating_sub(s);
+        ranges[kept] = (s, e);
+        kept += usize::from(length > 0);
+        total += length;
+    }
+    (kept, total)
 }
 
 /// Whether keys `a` and `b` are nodes of one strand at most `gap` apart (no branch).
@@ -401,6 +429,22 @@ fn within_sse2(x: &[f32; LANES], y: &[f32; LANES], z: &[f32; LANES], me: [f32; 3
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn empty_ranges_are_dropped_in_order_and_the_particles_counted() {
+        let mut ranges = [(0u32, 0u32); MAX_RANGES];
+        let given = [(4, 6), (9, 9), (1, 2), (7, 7), (3, 3), (10, 15), (20, 20)];
+        ranges[..given.len()].copy_from_slice(&given);
+        // Past `m`, nothing is read.
+        ranges[given.len()] = (30, 40);
+        let (kept, total) = without_empty(&mut ranges, given.len());
+        assert_eq!(&ranges[..kept], &[(4, 6), (1, 2), (10, 15)]);
+        assert_eq!(total, 2 + 1 + 5);
+        // A particle alone in its cells: only its own range, holding itself.
+        let mut alone = [(0u32, 0u32); MAX_RANGES];
+        alone[0] = (8, 9);
+        assert_eq!(without_empty(&mut alone, 9), (1, 1));
+    }
 
     #[test]
     fn the_packed_distance_test_is_the_scalar_one_bit_for_bit() {
