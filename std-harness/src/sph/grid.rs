@@ -115,8 +115,9 @@ const PARTS: usize = 64;
 /// particle alone in its 27 buckets is not tested at all (`super::neighbours`).
 pub const BUCKETS_PER_PARTICLE: usize = 8;
 
-/// The most rows (of [`ROW`] buckets): 2¹⁹ buckets, as many as a scene of 262,144 to 524,288
-/// particles had with one bucket a particle; dense hair has few empty ranges to drop.
+/// The most rows (of [`ROW`] buckets): 2¹⁹ buckets, 2 MiB of bucket starts. A scene of more
+/// than 65,536 particles has fewer than eight buckets a particle (Mannequin A's 345,000 have
+/// 1.5, as many as with one a particle rounded up to a power of two).
 pub const MAX_ROWS: usize = 1 << 13;
 
 /// Particles per work item of the counting sort's first and last passes (a constant of the

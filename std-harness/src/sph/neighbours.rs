@@ -198,8 +198,7 @@ impl Search<'_> {
                 }
             };
             let first = list.len();
-            // Alone in its 27 cells: no candidate, and nothing to test (most particles of a
-            // scene where little touches).
+            // Alone in its 27 cells: no candidate, and nothing to test.
             if around <= 1 {
                 *start = first as u32;
                 *count = 0;
