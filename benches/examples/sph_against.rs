@@ -5,7 +5,8 @@
 //!   writes its state (every node's position and velocity, and the head's pose) after 0.5 s
 //!   and after 1 s into `DIR`;
 //! - `evaluate DIR OUT`: builds the stage anew on each captured state and writes each node's
-//!   density and SPH acceleration, in strand order, into `OUT`;
+//!   density and SPH acceleration, in strand order, into `OUT`, printing a line per state:
+//!   the scene, the seconds and the node count;
 //! - `volume`: runs Mannequin A for 1 s at its own step on two threads and prints the mean
 //!   distance of its nodes from the head's centre, averaged over the steps.
 //!
@@ -159,6 +160,8 @@ fn evaluate<const N: usize>(size: &Size, dir: &Path, out: &mut impl Write) -> Re
             }
         }
         out.write_all(&bytes).map_err(|e| e.to_string())?;
+        // What was written, for the comparison to read it by.
+        println!("{} {seconds:.1} {p}", size.name);
     }
     Ok(())
 }
