@@ -4,7 +4,8 @@
 //! the wall time. Sizes of Sánchez-Banderas 2015 Table 2; per-strand path vs blocks of 8 and 16
 //! lanes, DFTL (gravity + inextensibility) and DFTL + shape; the 16-lane blocks also split over
 //! two threads (a rayon pool, a fixed partition; CPU time then counts both threads).
-//! Arguments that are not options select cases whose label contains them.
+//! Arguments that are not options select cases whose label contains them (or, ending in `$`,
+//! whose label ends with the rest).
 //!
 //! `cargo bench -p hairsim-benches --bench dftl_cpu`
 
@@ -88,7 +89,12 @@ fn wanted(label: &str) -> bool {
         .skip(1)
         .filter(|a| !a.starts_with("--"))
         .collect();
-    filters.is_empty() || filters.iter().any(|f| label.contains(f.as_str()))
+    filters.is_empty()
+        || filters.iter().any(|f| match f.strip_suffix('$') {
+            // `…dftl$`: the rows that end so (without shape), not the `dftl+shape` ones.
+            Some(end) => label.ends_with(end),
+            None => label.contains(f.as_str()),
+        })
 }
 
 fn measure(label: &str, vertices: usize, steps: u32, mut run: impl FnMut()) {
@@ -115,8 +121,22 @@ fn size<const N: usize>(count: usize, quick: bool) {
         (20_000_000 / vertices).max(10) as u32
     };
     for shape in [false, true] {
-        let ctx = contexts(shape, steps);
         let name = if shape { "dftl+shape" } else { "dftl" };
+        // The contexts and strands of a size no row wants are not built: a filtered run
+        // (old against new, an instruction count) does only the rows it names.
+        let prefix = format!("{count} x {N} ");
+        let any = [
+            "per-strand ",
+            "block-8 ",
+            "block-16 ",
+            "block-16 2 threads ",
+        ]
+        .iter()
+        .any(|path| wanted(&format!("{prefix}{path}{name}")));
+        if !any {
+            continue;
+        }
+        let ctx = contexts(shape, steps);
         let mut report = StepReport::default();
         let mut s = strands::<N>(count);
         measure(

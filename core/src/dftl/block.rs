@@ -241,8 +241,22 @@ impl<const W: usize, const N: usize> DftlBlock<W, N> {
         active: WideMask<W>,
         accelerations: Option<&[Vec3]>,
     ) -> Option<NodeInput<Wide<W>>> {
+        self.node_input_in(&self.state, k, active, accelerations)
+    }
+
+    /// [`Self::node_input`] with the state taken from `states` (the block's own, or a copy
+    /// kept at the start of the step).
+    #[inline(always)]
+    #[must_use]
+    pub fn node_input_in(
+        &self,
+        states: &[StateLanes<W>; N],
+        k: usize,
+        active: WideMask<W>,
+        accelerations: Option<&[Vec3]>,
+    ) -> Option<NodeInput<Wide<W>>> {
         let (extra, has_extra) = lane_accelerations::<W, N>(accelerations, k);
-        let (state, rest, shape) = (self.state.get(k)?, self.rest.get(k)?, self.shape.get(k)?);
+        let (state, rest, shape) = (states.get(k)?, self.rest.get(k)?, self.shape.get(k)?);
         Some(NodeInput {
             active,
             position: read_lanes(&state.position),

@@ -30,7 +30,9 @@
 //! stayed 3–7 cm from rest with it, 2.3 cm without).
 //!
 //! The solver finishes each node two nodes behind, as soon as the corrections of both nodes
-//! after it are known ([`Pending`]), so the whole step is still one pass.
+//! after it are known ([`Pending`]), so the whole step is still one pass. Without shape the
+//! local terms are zero and a node is whole one node behind: the blocks store it then
+//! (`pipeline::dftl::hand_on_lanes`).
 
 use super::node::Setup;
 use crate::lane::{Lane, V3};

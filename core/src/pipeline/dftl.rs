@@ -454,14 +454,9 @@ pub fn advance<M: Math, T: Lane>(
     measures: &mut Measures<T>,
     collider_push: &mut [V3<T>],
 ) -> Advanced<T> {
-    // Below 60 Hz, the shape damping: the velocity relative to the head's rigid motion.
-    let velocity = if setup.shape && setup.shape_damping {
-        damping::damped_velocity(setup, node.position, node.velocity)
-    } else {
-        node.velocity
-    };
-    // Lines 13–14: external accelerations, prediction (eq. 1).
-    let a = predict::acceleration(setup, velocity, node.mass, node.extra, node.has_extra);
+    // Below 60 Hz the shape damping, then lines 13–14: external accelerations, prediction
+    // (eq. 1).
+    let (velocity, a) = external_acceleration(setup, node);
     let mut x = predict::predicted_position(setup, node.position, velocity, a);
     // Line 18: shape, eqs. (8), (9) — the local target uses x* after the global step. Eq.
     // (14) feeds back the local and the follow-the-leader corrections, not the global one
@@ -523,6 +518,20 @@ pub fn advance<M: Math, T: Lane>(
     }
 }
 
+/// Node `node`'s velocity after the shape damping (below 60 Hz: the velocity relative to
+/// the head's rigid motion, `dftl::damping`) and its external acceleration (lines 13–14),
+/// which the prediction takes.
+#[inline(always)]
+fn external_acceleration<T: Lane>(setup: &Setup, node: &NodeInput<T>) -> (V3<T>, V3<T>) {
+    let velocity = if setup.shape && setup.shape_damping {
+        damping::damped_velocity(setup, node.position, node.velocity)
+    } else {
+        node.velocity
+    };
+    let a = predict::acceleration(setup, velocity, node.mass, node.extra, node.has_extra);
+    (velocity, a)
+}
+
 /// Node `node`'s momentum at the step's end under the external forces alone, `m (v + a Δt)`
 /// with its velocity as the step found it (the shape damping is the head's doing too) and its
 /// external acceleration `a`; zero where the lane does not have the node. What the step's
@@ -544,10 +553,12 @@ pub fn step_blocks<M: Math, const W: usize, const N: usize>(
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
+    // Once for all the blocks, not once a block (about 250 instructions each, callgrind).
+    let setup = Setup::new(ctx);
     for (b, block) in blocks.iter_mut().enumerate() {
         let block_accelerations = accelerations.and_then(|a| a.get(b * W * N..));
         let first = first_strand.wrapping_add((b * W) as u32);
-        step_block::<M, W, N>(ctx, block, first, block_accelerations, report);
+        step_block_with::<M, W, N>(ctx, &setup, block, first, block_accelerations, report);
     }
 }
 
@@ -581,7 +592,7 @@ pub fn step_strands_in_blocks<M: Math, const W: usize, const N: usize>(
             }
         } else {
             block.load_state(chunk);
-            step_block::<M, W, N>(ctx, block, first, of_block, report);
+            step_block_with::<M, W, N>(ctx, &setup, block, first, of_block, report);
             block.store(chunk);
         }
     }
@@ -596,7 +607,26 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) {
-    let setup = Setup::new(ctx);
+    step_block_with::<M, W, N>(
+        ctx,
+        &Setup::new(ctx),
+        block,
+        first_strand,
+        accelerations,
+        report,
+    );
+}
+
+/// [`step_block`] with `setup`, [`Setup::new`] of `ctx`, built once for all blocks.
+#[inline(always)]
+fn step_block_with<M: Math, const W: usize, const N: usize>(
+    ctx: &StepContext,
+    setup: &Setup,
+    block: &mut DftlBlock<W, N>,
+    first_strand: u32,
+    accelerations: Option<&[Vec3]>,
+    report: &mut StepReport,
+) {
     let lanes = block.strands.min(W) as u32;
     // Quarantine: every lane's last good state.
     let last_good: BlockState<W, N> = snapshot(block, report);
@@ -605,10 +635,10 @@ pub fn step_block<M: Math, const W: usize, const N: usize>(
     // The root follows the head: nodes 0 and 1 of every lane.
     let roots = root_coupling(block, ctx, report);
     // Lines 16–27 in one pass from the root, all lanes together.
-    count_constraints(&setup, lanes, report);
+    count_constraints(setup, lanes, report);
     let pass = with_effect_switches!(
         setup,
-        block_pass::<M, W, N>(ctx, &setup, block, accelerations, report)
+        block_pass::<M, W, N>(ctx, setup, (block, &last_good), accelerations, report)
     );
     // Quarantine: a lane that wrote a non-finite value gets its last good positions back.
     let (pass, head_forces) = pass;
@@ -633,9 +663,6 @@ struct Carried<'a, const W: usize> {
     measures: &'a mut Measures<Wide<W>>,
     collider_push: &'a mut ColliderPush<Wide<W>>,
     velocity_total: &'a mut Wide<W>,
-    /// Each node's momentum under the external forces alone ([`kicked`]), by node: summed
-    /// after the pass ([`lost_momenta`]), not carried from node to node.
-    kicked: &'a mut [V3<Wide<W>>],
 }
 
 /// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
@@ -652,7 +679,7 @@ fn block_pass<
 >(
     ctx: &StepContext,
     setup: &Setup,
-    block: &mut DftlBlock<W, N>,
+    (block, start): (&mut DftlBlock<W, N>, &BlockState<W, N>),
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
 ) -> (Wide<W>, [Vec3; W]) {
@@ -679,13 +706,11 @@ fn block_pass<
     let mut collider_push: ColliderPush<Wide<W>> = [V3::zero(); MAX_COLLIDERS];
     let mut previous_contact = Wide::<W>::mask(false);
     let mut pending = Pending::start();
-    // The head force's sum, kept apart: carried through the node loop beside the chain, its
-    // three vectors of lanes spilled the loop (8-lane blocks of DFTL + shape ran a quarter
-    // slower).
-    let mut kicked = [V3::zero(); N];
     // Nodes every lane has: there every lane is active and every selection below is a
     // constant (the same bits as the masked form, without its blends).
     let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
+    // Once for the block: `StepContext::colliders` stayed a call at every node.
+    let colliders = ctx.colliders();
     for k in 2..max_nodes {
         let carried = Carried {
             chain: &mut chain,
@@ -694,15 +719,14 @@ fn block_pass<
             measures: &mut measures,
             collider_push: &mut collider_push,
             velocity_total: &mut velocity_total,
-            kicked: &mut kicked,
         };
         // Nodes 2 and 3 finish nothing (node 1 is held) and past the shortest lane the masks
         // select: both take the masked copy, so the pass holds two copies of a node, not four.
         let (b, a, n) = (&mut *block, accelerations, nodes_real);
         if k >= 4 && k < common {
-            block_node::<M, W, N, true>(ctx, &setup, b, k, n, a, carried);
+            block_node::<M, W, N, true>(colliders, &setup, b, k, n, a, carried);
         } else {
-            block_node::<M, W, N, false>(ctx, &setup, b, k, n, a, carried);
+            block_node::<M, W, N, false>(colliders, &setup, b, k, n, a, carried);
         }
     }
     // The last two nodes of the longest lanes: no node after them.
@@ -713,7 +737,10 @@ fn block_pass<
         let written = hand_on_lanes(&setup, b, at, &mut pending, x_star, (zero, zero));
         velocity_total += written;
     }
-    let momenta = lost_momenta(block, &kicked, nodes_real);
+    // The head force's sum, after the pass: carried through the node loop beside the chain,
+    // its three vectors of lanes spilled the loop (8-lane blocks of DFTL + shape ran a quarter
+    // slower).
+    let momenta = lost_momenta(&setup, (block, start), accelerations, nodes_real);
     let measured = (&measures, &collider_push, momenta);
     let head_forces = tally_lanes::<M, W, N>(ctx, &setup, block, measured, report);
     (velocity_total, head_forces)
@@ -729,7 +756,7 @@ fn free_lanes<const W: usize>(k: usize, nodes_real: Wide<W>) -> WideMask<W> {
 /// where it is free (`k ≥ 4`). With `ALL` every lane has both nodes: the masks are constants.
 #[inline(always)]
 fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
-    ctx: &StepContext,
+    colliders: &[Shape],
     setup: &Setup,
     block: &mut DftlBlock<W, N>,
     k: usize,
@@ -748,16 +775,13 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
     // Lines 13–21, the per-strand path's function on every lane.
     let next = advance::<M, Wide<W>>(
         setup,
-        ctx.colliders(),
+        colliders,
         &node,
         &*carried.chain,
         *carried.previous_contact,
         carried.measures,
         carried.collider_push,
     );
-    if let Some(slot) = carried.kicked.get_mut(k) {
-        *slot = kicked(setup, &node, next.acceleration);
-    }
     // Lines 24–26 for nodes k − 1 and k − 2; a lane past its last node hands on zeros, as
     // the per-strand path does after a strand's last node.
     let local = V3::select(active, next.local, V3::zero());
@@ -777,7 +801,8 @@ fn block_node<M: Math, const W: usize, const N: usize, const ALL: bool>(
 
 /// Lines 24–26 once node `k` of every lane is advanced (or, past a lane's end, with zero
 /// corrections), as the per-strand path's `hand_on`: node `k − 1`'s final position `x_star`
-/// is stored where `moving` (it is free), and node `k − 2`'s velocity where `finishing`.
+/// is stored where `moving` (it is free), and node `k − 2`'s velocity where `finishing` (node
+/// `k − 1`'s where `moving` without shape).
 /// Returns the [`component_sum`] of the velocities stored, 0 in the other lanes (whose
 /// velocities the last guard saw finite): each lane's total adds its strand's per-strand terms
 /// in the same order, and zeros, which change no verdict. Constant masks fold away.
@@ -797,34 +822,80 @@ fn hand_on_lanes<const W: usize, const N: usize>(
     let x = V3::select(moving, x, x_star);
     let (finished, next) = pending.hand_on(setup, x_star, x, local, inextensible);
     block.store_position_where(k - 1, moving, x_star);
+    if !setup.shape {
+        // Without shape no reaction reaches two nodes back: node `k − 1`'s velocity is whole
+        // now and is stored beside its position, not carried to the next node (the same
+        // values, added to the totals in the same node order).
+        let stored = block.store_velocity_where(k - 1, moving, next.velocity);
+        return Wide::select(moving, component_sum(stored), Wide::splat(0.0));
+    }
     *pending = next;
     let stored = block.store_velocity_where(k - 2, finishing, finished);
     Wide::select(finishing, component_sum(stored), Wide::splat(0.0))
 }
 
-/// The free nodes' momenta over a block's pass ([`Momenta`]) from each node's `kicked`
-/// momentum and the velocities the pass stored, added in the order the per-strand node loop
-/// adds them (node `k`'s kick, then node `k − 2`'s final momentum taken away), so each lane
-/// has its strand's bits.
+/// The free nodes' momenta over a block's pass ([`Momenta`]): each node's momentum under the
+/// external forces alone ([`kicked`]), from its state at the step's `start` (the snapshot the
+/// guard keeps) and the same acceleration the pass computed from it, and the velocities the
+/// pass stored, added in the order the per-strand node loop adds them (node `k`'s kick, then
+/// node `k − 2`'s final momentum taken away), so each lane has its strand's bits. Recomputing
+/// the kicks here costs less than keeping them in the pass: an array of them was zeroed and
+/// written for every block.
 #[inline(always)]
 fn lost_momenta<const W: usize, const N: usize>(
-    block: &DftlBlock<W, N>,
-    kicked: &[V3<Wide<W>>; N],
+    setup: &Setup,
+    (block, start): (&DftlBlock<W, N>, &BlockState<W, N>),
+    accelerations: Option<&[Vec3]>,
     nodes_real: Wide<W>,
 ) -> Momenta<Wide<W>> {
     let max_nodes = block.max_nodes.min(N);
+    let common = block
+        .nodes
+        .iter()
+        .copied()
+        .min()
+        .unwrap_or(0)
+        .min(max_nodes);
     let mut lost = V3::zero();
     for k in 2..max_nodes + 2 {
-        if let Some(&kick) = kicked.get(k).filter(|_| k < max_nodes) {
-            lost += kick;
-        }
-        let finishing = free_lanes(k - 2, nodes_real);
-        if let (Some(state), Some(mass)) = (block.state.get(k - 2), block.mass.get(k - 2)) {
-            let taken = lost - read_lanes(&state.velocity).scale(Wide::new(*mass));
-            lost = V3::select(finishing, taken, lost);
+        // As in the pass: where every lane has nodes `k` and `k − 2` free, the masks are
+        // constants and their selections fold away.
+        let at = (block, start, accelerations);
+        if k >= 4 && k < common {
+            lose_momentum_at::<W, N, true>(setup, at, k, nodes_real, &mut lost);
+        } else {
+            lose_momentum_at::<W, N, false>(setup, at, k, nodes_real, &mut lost);
         }
     }
     Momenta { lost }
+}
+
+/// [`lost_momenta`] at node `k`: node `k`'s kick added, node `k − 2`'s final momentum taken
+/// away. With `ALL` every lane has both nodes free.
+#[inline(always)]
+fn lose_momentum_at<const W: usize, const N: usize, const ALL: bool>(
+    setup: &Setup,
+    (block, start, accelerations): (&DftlBlock<W, N>, &BlockState<W, N>, Option<&[Vec3]>),
+    k: usize,
+    nodes_real: Wide<W>,
+    lost: &mut V3<Wide<W>>,
+) {
+    let (active, finishing) = if ALL {
+        (Wide::<W>::mask(true), Wide::<W>::mask(true))
+    } else {
+        (free_lanes(k, nodes_real), free_lanes(k - 2, nodes_real))
+    };
+    if let Some(node) = block
+        .node_input_in(&start.0, k, active, accelerations)
+        .filter(|_| k < block.max_nodes)
+    {
+        let (_, a) = external_acceleration(setup, &node);
+        *lost += kicked(setup, &node, a);
+    }
+    if let (Some(state), Some(mass)) = (block.state.get(k - 2), block.mass.get(k - 2)) {
+        let taken = *lost - read_lanes(&state.velocity).scale(Wide::new(*mass));
+        *lost = V3::select(finishing, taken, *lost);
+    }
 }
 
 /// The masks of [`hand_on_lanes`] at node `k`: node `k − 1` free and in the lane, node
