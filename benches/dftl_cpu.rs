@@ -112,6 +112,9 @@ fn measure(label: &str, vertices: usize, steps: u32, mut run: impl FnMut()) {
     );
 }
 
+/// The paths each size times, as its rows' labels name them.
+const PATHS: [&str; 4] = ["per-strand", "block-8", "block-16", "block-16 2 threads"];
+
 fn size<const N: usize>(count: usize, quick: bool) {
     let vertices = count * N;
     // About 20 M vertex-steps per run; one step each under `cargo test --benches`.
@@ -122,63 +125,40 @@ fn size<const N: usize>(count: usize, quick: bool) {
     };
     for shape in [false, true] {
         let name = if shape { "dftl+shape" } else { "dftl" };
+        let label = |path: &str| format!("{count} x {N} {path} {name}");
         // The contexts and strands of a size no row wants are not built: a filtered run
         // (old against new, an instruction count) does only the rows it names.
-        let prefix = format!("{count} x {N} ");
-        let any = [
-            "per-strand ",
-            "block-8 ",
-            "block-16 ",
-            "block-16 2 threads ",
-        ]
-        .iter()
-        .any(|path| wanted(&format!("{prefix}{path}{name}")));
-        if !any {
+        if !PATHS.iter().any(|path| wanted(&label(path))) {
             continue;
         }
         let ctx = contexts(shape, steps);
         let mut report = StepReport::default();
         let mut s = strands::<N>(count);
-        measure(
-            &format!("{count} x {N} per-strand {name}"),
-            vertices,
-            steps,
-            || {
-                for c in &ctx {
-                    step_strands::<HostMath, N>(c, &mut s, 0, &[], None, &mut report);
-                }
-            },
-        );
+        measure(&label("per-strand"), vertices, steps, || {
+            for c in &ctx {
+                step_strands::<HostMath, N>(c, &mut s, 0, &[], None, &mut report);
+            }
+        });
         let source = strands::<N>(count);
         let mut b8: Vec<DftlBlock<8, N>> = source.chunks(8).map(DftlBlock::from_strands).collect();
-        measure(
-            &format!("{count} x {N} block-8 {name}"),
-            vertices,
-            steps,
-            || {
-                for c in &ctx {
-                    step_blocks::<HostMath, 8, N>(c, &mut b8, 0, None, &mut report);
-                }
-            },
-        );
+        measure(&label("block-8"), vertices, steps, || {
+            for c in &ctx {
+                step_blocks::<HostMath, 8, N>(c, &mut b8, 0, None, &mut report);
+            }
+        });
         let mut b16: Vec<DftlBlock<16, N>> =
             source.chunks(16).map(DftlBlock::from_strands).collect();
-        measure(
-            &format!("{count} x {N} block-16 {name}"),
-            vertices,
-            steps,
-            || {
-                for c in &ctx {
-                    step_blocks::<HostMath, 16, N>(c, &mut b16, 0, None, &mut report);
-                }
-            },
-        );
+        measure(&label("block-16"), vertices, steps, || {
+            for c in &ctx {
+                step_blocks::<HostMath, 16, N>(c, &mut b16, 0, None, &mut report);
+            }
+        });
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(2)
             .build()
             .expect("a pool of two threads");
         measure(
-            &format!("{count} x {N} block-16 2 threads {name}"),
+            &label("block-16 2 threads"),
             vertices,
             steps,
             // Two halves of the blocks on a pool of two threads (a fixed partition: the

@@ -740,7 +740,7 @@ fn block_pass<
     // The head force's sum, after the pass: carried through the node loop beside the chain,
     // its three vectors of lanes spilled the loop (8-lane blocks of DFTL + shape ran a quarter
     // slower).
-    let momenta = lost_momenta(&setup, (block, start), accelerations, nodes_real);
+    let momenta = lost_momenta(&setup, (block, start), accelerations, (nodes_real, common));
     let measured = (&measures, &collider_push, momenta);
     let head_forces = tally_lanes::<M, W, N>(ctx, &setup, block, measured, report);
     (velocity_total, head_forces)
@@ -838,24 +838,17 @@ fn hand_on_lanes<const W: usize, const N: usize>(
 /// external forces alone ([`kicked`]), from its state at the step's `start` (the snapshot the
 /// guard keeps) and the same acceleration the pass computed from it, and the velocities the
 /// pass stored, added in the order the per-strand node loop adds them (node `k`'s kick, then
-/// node `k − 2`'s final momentum taken away), so each lane has its strand's bits. Recomputing
-/// the kicks here costs less than keeping them in the pass: an array of them was zeroed and
-/// written for every block.
+/// node `k − 2`'s final momentum taken away), so each lane has its strand's bits; `common` is
+/// the node count every lane has. Computing the kicks again costs less than an array of them
+/// the pass would zero and write for every block.
 #[inline(always)]
 fn lost_momenta<const W: usize, const N: usize>(
     setup: &Setup,
     (block, start): (&DftlBlock<W, N>, &BlockState<W, N>),
     accelerations: Option<&[Vec3]>,
-    nodes_real: Wide<W>,
+    (nodes_real, common): (Wide<W>, usize),
 ) -> Momenta<Wide<W>> {
     let max_nodes = block.max_nodes.min(N);
-    let common = block
-        .nodes
-        .iter()
-        .copied()
-        .min()
-        .unwrap_or(0)
-        .min(max_nodes);
     let mut lost = V3::zero();
     for k in 2..max_nodes + 2 {
         // As in the pass: where every lane has nodes `k` and `k − 2` free, the masks are
