@@ -6,7 +6,8 @@
 //! pair within the smoothing length `h` (Verlet lists with a skin, measured in the head's
 //! frame: [`skin`]), and a step works only on the particles that have a candidate. Each step:
 //! 1. [`skin`] reads every node and checks whether one has moved by half the skin since the
-//!    lists were built; if so, or at the first step, the lists are rebuilt:
+//!    lists were built; if so, or at the first step, or where the last rebuild found that no
+//!    skin would make the lists last (the check is then skipped), the lists are rebuilt:
 //!    [`grid`] hashes every node (in the head's frame) into cells of `h + skin` and sorts them
 //!    by bucket with a stable counting sort (Algorithm 1 lines 2–4), and [`neighbours`] lists
 //!    each particle's candidates within `h + skin`; [`active`] keeps the particles that have
@@ -55,7 +56,9 @@ const STRANDS_PER_CHUNK: usize = 64;
 /// A larger skin makes rebuilds rarer and every step's filter longer. At a rebuild the skin is
 /// set for the lists to last [`LASTING`] steps at the pace the fastest node moved since the
 /// last one; where even the largest skin would not make them last that long, rebuilds come at
-/// every step anyway and the skin is the least. It changes the cost, never the result.
+/// every step anyway, the skin is the least and the next step rebuilds without reading every
+/// node first to check (the rebuild measures the moves as it reads them). It changes the cost,
+/// never the result.
 pub const SKIN: [f32; 3] = [0.5, 0.05, 1.0];
 
 /// The steps a list is sized to last.
@@ -98,6 +101,12 @@ pub struct Sph {
     skin: f32,
     /// Steps since the last rebuild.
     since_rebuild: u64,
+    /// Whether the last rebuild found that even the largest skin would not make the lists
+    /// last: the next step rebuilds without checking the moves first.
+    every_step: bool,
+    /// How far the fastest node had moved since the rebuild before, measured at the last
+    /// rebuild, m (infinite when unknown).
+    last_move: f32,
     /// Acceleration slot (`strand · N + node`) of each particle.
     slot: Vec<u32>,
     /// Key (`strand << NODE_BITS | node`) of each particle.
@@ -167,6 +176,8 @@ impl Sph {
             params,
             skin,
             since_rebuild: 0,
+            every_step: false,
+            last_move: f32::INFINITY,
             grid: grid::Grid::new(count, params.smoothing_length + skin, extent(strands)),
             sorted: neighbours::Sorted::new(count),
             candidates: neighbours::CandidateLists::new(count),
@@ -244,9 +255,14 @@ impl Sph {
         let t0 = Instant::now();
         let frame = skin::Frame::of(head);
         self.since_rebuild += 1;
-        let (moved, furthest) = self
-            .reference
-            .moved(strands, &self.first, &frame, self.skin);
+        // Where the lists cannot last a step, reading every node to find that out is skipped:
+        // the rebuild measures the moves as it reads the nodes anyway.
+        let (moved, furthest) = if self.every_step {
+            (true, self.last_move)
+        } else {
+            self.reference
+                .moved(strands, &self.first, &frame, self.skin)
+        };
         let mut times = [t0.elapsed(), Duration::ZERO, Duration::ZERO];
         if moved {
             self.adapt_skin(furthest);
@@ -293,14 +309,15 @@ impl Sph {
         // Algorithm 1, line 2: every node in the frame, and its cell's bucket.
         let (inverse_cell, layout) = (self.grid.inverse_cell(), self.grid.layout());
         let key = &self.key;
-        let largest = (
+        let built = self.reference.built;
+        let (largest, furthest) = (
             self.reference.position.par_chunks_mut(CHUNK),
             self.bucket.par_chunks_mut(CHUNK),
         )
             .into_par_iter()
             .enumerate()
             .map(|(c, (reference, bucket))| {
-                let mut largest = 0.0f32;
+                let (mut largest, mut furthest) = (0.0f32, 0.0f32);
                 for (k, (r, b)) in reference.iter_mut().zip(bucket).enumerate() {
                     let own = key[c * CHUNK + k];
                     let (s, i) = (
@@ -312,12 +329,21 @@ impl Sph {
                         .map_or(Vec3::ZERO, |s| s.state.position[i % N]);
                     let y = frame.local(x);
                     largest = largest.max(x.abs().max_element().max(y.abs().max_element()));
+                    furthest = skin::further(furthest, (y - Vec3::from_array(*r)).length_squared());
                     *r = y.to_array();
                     *b = grid::bucket_of(grid::cell_of(y, inverse_cell), layout);
                 }
-                largest
+                (largest, furthest)
             })
-            .reduce(|| 0.0, f32::max);
+            .reduce(
+                || (0.0, 0.0),
+                |a, b| (a.0.max(b.0), skin::further(a.1, b.1)),
+            );
+        self.last_move = if built {
+            furthest.sqrt()
+        } else {
+            f32::INFINITY
+        };
         self.reference.largest = largest;
         self.reference.built = true;
         let t1 = Instant::now();
@@ -363,10 +389,11 @@ impl Sph {
             return;
         }
         let wanted = 2.0 * LASTING * furthest / steps;
-        self.skin = if wanted <= h * SKIN[2] {
-            wanted.max(h * SKIN[1])
-        } else {
+        self.every_step = wanted > h * SKIN[2];
+        self.skin = if self.every_step {
             h * SKIN[1]
+        } else {
+            wanted.max(h * SKIN[1])
         };
     }
 
@@ -634,35 +661,43 @@ mod tests {
         }
     }
 
-    #[test]
-    fn the_result_does_not_depend_on_the_lists_age_nor_on_the_frame() {
-        // One Sph steps along a drifting, turning tangle (its lists rebuilt now and then),
-        // another is built anew at every step (its lists fresh): the same bits each step.
-        let mut strands = tangle(40, 5);
+    /// A tangle of 40 strands and a stage for it, the rest density low enough to push.
+    fn tangle_and_stage(seed: u32) -> (Vec<Strand<8>>, Sph) {
+        let strands = tangle(40, seed);
         let params = SphParams {
             rest_density: 0.5,
             ..SphParams::default()
         };
-        let mut kept = Sph::new(params, &strands).unwrap();
+        let stage = Sph::new(params, &strands).unwrap();
+        (strands, stage)
+    }
+
+    /// Steps `kept` on `strands` with the head at `head`, and a stage built anew with the head
+    /// at rest: the same bits, or the test fails at step `k`.
+    fn same_bits_as_fresh(kept: &mut Sph, strands: &[Strand<8>], head: Pose, k: usize) {
+        let bits = |v: &[Vec3]| {
+            v.iter()
+                .map(|v| v.to_array().map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
+        let params = *kept.params();
+        let a = bits(kept.accelerations(strands, 0.001, head));
+        let mut fresh = Sph::new(params, strands).unwrap();
+        let b = bits(fresh.accelerations(strands, 0.001, Pose::IDENTITY));
+        assert_eq!(a, b, "step {k}");
+    }
+
+    #[test]
+    fn the_result_does_not_depend_on_the_lists_age_nor_on_the_frame() {
+        // One Sph steps along a drifting, turning tangle (its lists rebuilt now and then),
+        // another is built anew at every step (its lists fresh): the same bits each step.
+        let (mut strands, mut kept) = tangle_and_stage(5);
         for k in 0..40 {
             let head = Pose {
                 position: Vec3::new(0.001 * k as f32, 0.0, 0.0),
                 rotation: hairsim_core::Quat::from_rotation_y(0.05 * k as f32),
             };
-            let a = kept.accelerations(&strands, 0.001, head).to_vec();
-            let mut fresh = Sph::new(params, &strands).unwrap();
-            let b = fresh
-                .accelerations(&strands, 0.001, Pose::IDENTITY)
-                .to_vec();
-            assert_eq!(
-                a.iter()
-                    .map(|v| v.to_array().map(f32::to_bits))
-                    .collect::<Vec<_>>(),
-                b.iter()
-                    .map(|v| v.to_array().map(f32::to_bits))
-                    .collect::<Vec<_>>(),
-                "step {k}"
-            );
+            same_bits_as_fresh(&mut kept, &strands, head, k);
             // Each node drifts by its velocity (0.1 to 1 mm a step) and the whole turns with
             // the head.
             for s in &mut strands {
@@ -679,6 +714,34 @@ mod tests {
             kept.stats.rebuilds
         );
         assert!(kept.stats.neighbours > 1000);
+    }
+
+    #[test]
+    fn skipping_the_check_where_lists_cannot_last_changes_no_bit() {
+        // The tangle moves fast (up to 3.5 mm a step, h = 1 cm: no skin lasts four steps),
+        // then stands still, then moves again: the kept stage rebuilds without the check
+        // while it moves, keeps its lists while it stands, and every step has the bits of a
+        // stage built anew.
+        let (mut strands, mut kept) = tangle_and_stage(9);
+        let (mut skipped, mut kept_lists) = (0, 0);
+        for k in 0..60 {
+            let (skipping, rebuilds) = (kept.every_step, kept.stats.rebuilds);
+            same_bits_as_fresh(&mut kept, &strands, Pose::IDENTITY, k);
+            skipped += u32::from(skipping);
+            kept_lists += u32::from(kept.stats.rebuilds == rebuilds);
+            let pace = if (20..40).contains(&k) { 0.0 } else { 0.002 };
+            for s in &mut strands {
+                for i in 0..8 {
+                    let v = s.state.velocity[i] * pace;
+                    s.state.position[i] += v;
+                }
+            }
+        }
+        assert!(
+            skipped >= 30 && kept_lists >= 15,
+            "{skipped} skipped, {kept_lists} kept"
+        );
+        assert!(kept.stats.neighbours > 100);
     }
 
     #[test]

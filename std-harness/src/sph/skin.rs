@@ -97,26 +97,27 @@ impl Reference {
                     for (&x, y0) in strand.state.position[..nodes].iter().zip(reference) {
                         let y = frame.local(x);
                         // NaN moves "infinitely": `max` would drop it; once in, it stays.
-                        let d = (y - Vec3::from_array(*y0)).length_squared();
-                        furthest = if d > furthest || d.is_nan() {
-                            d
-                        } else {
-                            furthest
-                        };
+                        furthest = further(furthest, (y - Vec3::from_array(*y0)).length_squared());
                         largest = largest.max(x.abs().max_element().max(y.abs().max_element()));
                     }
                 }
                 (furthest, largest)
             })
-            .reduce(
-                || (0.0, 0.0),
-                |a, b| {
-                    let furthest = if b.0 > a.0 || b.0.is_nan() { b.0 } else { a.0 };
-                    (furthest, a.1.max(b.1))
-                },
-            );
+            .reduce(|| (0.0, 0.0), |a, b| (further(a.0, b.0), a.1.max(b.1)));
         let limit = skin / 2.0 - margin(largest.max(self.largest));
         (!(limit > 0.0 && furthest <= limit * limit), furthest.sqrt())
+    }
+}
+
+/// The larger of two moves, a NaN move being the largest: `f32::max` would drop it, and once
+/// in it stays.
+#[inline(always)]
+#[must_use]
+pub fn further(furthest: f32, d: f32) -> f32 {
+    if d > furthest || d.is_nan() {
+        d
+    } else {
+        furthest
     }
 }
 
