@@ -709,7 +709,8 @@ fn block_pass<
     // Nodes every lane has: there every lane is active and every selection below is a
     // constant (the same bits as the masked form, without its blends).
     let common = nodes.iter().copied().min().unwrap_or(0).min(max_nodes);
-    // Once for the block: `StepContext::colliders` stayed a call at every node.
+    // Once for the block: the compiler does not hoist `StepContext::colliders` out of the
+    // node loop.
     let colliders = ctx.colliders();
     for k in 2..max_nodes {
         let carried = Carried {
@@ -738,7 +739,7 @@ fn block_pass<
         velocity_total += written;
     }
     // The head force's sum, after the pass: carried through the node loop beside the chain,
-    // its three vectors of lanes spilled the loop (8-lane blocks of DFTL + shape ran a quarter
+    // its three vectors of lanes spill the loop (8-lane blocks of DFTL + shape a quarter
     // slower).
     let momenta = lost_momenta(&setup, (block, start), accelerations, (nodes_real, common));
     let measured = (&measures, &collider_push, momenta);
@@ -878,12 +879,11 @@ fn lose_momentum_at<const W: usize, const N: usize, const ALL: bool>(
     } else {
         (free_lanes(k, nodes_real), free_lanes(k - 2, nodes_real))
     };
-    if let Some(node) = block
-        .node_input_in(&start.0, k, active, accelerations)
-        .filter(|_| k < block.max_nodes)
-    {
-        let (_, a) = external_acceleration(setup, &node);
-        *lost += kicked(setup, &node, a);
+    if k < block.max_nodes {
+        if let Some(node) = block.node_input_in(&start.0, k, active, accelerations) {
+            let (_, a) = external_acceleration(setup, &node);
+            *lost += kicked(setup, &node, a);
+        }
     }
     if let (Some(state), Some(mass)) = (block.state.get(k - 2), block.mass.get(k - 2)) {
         let taken = *lost - read_lanes(&state.velocity).scale(Wide::new(*mass));
