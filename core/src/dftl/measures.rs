@@ -219,21 +219,21 @@ impl Tally {
         lost * inv_dt + pushed * (inv_dt * inv_dt)
     }
 
-    /// Folds the tally into `report`: maxima and counts, and each collider's contact force
-    /// `−Σ m Δx^push / Δt²` (the hair's push on the collider, as the rod solver reports it),
-    /// added strand by strand in strand order, for the scene's colliders in use, whose pushes
-    /// `collider_push` holds (none with collisions off; the others have no push to add).
-    pub fn report(&self, report: &mut StepReport, collider_push: &[V3<Real>], inv_dt: Real) {
+    /// Folds the tally's maxima and counts into `report`. The pushes on the colliders wait for
+    /// the guard's verdict ([`Tally::report_pushes`]).
+    pub fn report(&self, report: &mut StepReport) {
         // `Lane::max`, a compare: `f32::max` is a library call on the Cortex-M4F.
         report.max_stretch = Lane::max(report.max_stretch, self.stretch);
         report.max_contact_stretch = Lane::max(report.max_contact_stretch, self.contact_stretch);
         report.max_penetration = Lane::max(report.max_penetration, self.penetration);
         report.contacts += self.contacts;
-        Self::report_pushes(report, collider_push, inv_dt);
     }
 
-    /// Each collider's contact force `−Σ m Δx^push / Δt²` from `collider_push` into `report`
-    /// ([`Tally::report`]).
+    /// Each collider's contact force `−Σ m Δx^push / Δt²` (the hair's push on the collider, as
+    /// the rod solver reports it) from `collider_push` into `report`, for the scene's colliders
+    /// in use, whose pushes `collider_push` holds (none with collisions off; the others have no
+    /// push to add). Added strand by strand in strand order, for a strand whose step the guard
+    /// kept: a strand rolled back did not push (and a lane that went NaN would add NaN).
     pub fn report_pushes(report: &mut StepReport, collider_push: &[V3<Real>], inv_dt: Real) {
         let scale = -(inv_dt * inv_dt);
         for (force, &push) in report.collider_forces.iter_mut().zip(collider_push) {

@@ -175,11 +175,12 @@ fn step_free_strand<M: Math, const N: usize>(
     let mut pass = 0.0;
     let passing = (accelerations, &mut *push, &mut *last_good);
     let tally = strand_pass::<M, N>(setup, ctx, strand, passing, &mut pass);
-    tally.report(report, push, setup.inv_dt);
+    tally.report(report);
     // Quarantine: every value written finite, or the last good positions back.
     let good = not_finite_sum(roots + pass) == 0.0;
     let last_good = PassedPositions(last_good);
     let rolled_back = guard(strand, &last_good, |_, _| good, index, report);
+    transmit_to_colliders(push, setup.inv_dt, rolled_back, report);
     transmit_to_head(tally.head_force, rolled_back, report);
 }
 
@@ -228,9 +229,8 @@ fn step_held_strand<M: Math, const N: usize>(
     let mut pass = 0.0;
     let passing = (accelerations, &mut *push, &mut *last_good);
     let tally = strand_pass::<M, N>(&unprojected, ctx, strand, passing, &mut pass);
-    // The pass's push-outs act on the hair; its strain is the unprojected one: the
-    // projection measures the segments and the contacts after it.
-    Tally::report_pushes(report, push, setup.inv_dt);
+    // The pass's push-outs act on the hair (reported after the guard); its strain is the
+    // unprojected one: the projection measures the segments and the contacts after it.
     let unprojected_momentum = strand_momentum(strand);
     // Lines 5–8 of Kmoch's Algorithm 1: inextensibility, collisions and the grabs.
     let at = (grabs, index);
@@ -244,12 +244,27 @@ fn step_held_strand<M: Math, const N: usize>(
     if rolled_back {
         forces_after_roll_back(ctx, grabs, (strand, index), report);
     }
+    transmit_to_colliders(push, setup.inv_dt, rolled_back, report);
     // What the head feels: the momentum the step gave besides the external forces, the
     // colliders' and the grabs' (the projection reports what those feel, so less that).
     let lost = tally.lost + unprojected_momentum - strand_momentum(strand);
     let head =
         Tally::head_force(lost, push, setup.inv_dt) - outcome.collider_felt - outcome.grab_felt;
     transmit_to_head(head, rolled_back, report);
+}
+
+/// What one strand's pass pushed on the scene's colliders in use, `push`, into the report's
+/// `collider_forces` ([`Tally::report_pushes`]): nothing from a strand rolled back.
+#[inline(always)]
+fn transmit_to_colliders(
+    push: &[V3<Real>],
+    inv_dt: Real,
+    rolled_back: bool,
+    report: &mut StepReport,
+) {
+    if !rolled_back {
+        Tally::report_pushes(report, push, inv_dt);
+    }
 }
 
 /// What one strand transmits to the head this step, `force`, into the report's `head_force`:
@@ -636,12 +651,12 @@ fn step_block_with<M: Math, const W: usize, const N: usize>(
     let roots = root_coupling(block, ctx, report);
     // Lines 16–27 in one pass from the root, all lanes together.
     count_constraints(setup, lanes, report);
+    let at = (&mut *block, &last_good);
     let pass = with_effect_switches!(
         setup,
-        block_pass::<M, W, N>(ctx, setup, (block, &last_good), accelerations, report)
+        block_pass::<M, W, N>(ctx, setup, at, roots, accelerations, report)
     );
     // Quarantine: a lane that wrote a non-finite value gets its last good positions back.
-    let (pass, head_forces) = pass;
     let verdict = not_finite_sum(roots + pass);
     guard(
         block,
@@ -650,9 +665,6 @@ fn step_block_with<M: Math, const W: usize, const N: usize>(
         first_strand,
         report,
     );
-    for (l, &force) in head_forces.iter().enumerate().take(lanes as usize) {
-        transmit_to_head(force, verdict.0[l] != 0.0, report);
-    }
 }
 
 /// What the node loop of a block carries from node to node.
@@ -666,8 +678,10 @@ struct Carried<'a, const W: usize> {
 }
 
 /// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
-/// tally into the report. Returns, per lane, the [`component_sum`]s of the velocities it
-/// wrote, added, and the force the head feels from it (reported after the guard).
+/// tally into the report: its measures and, unless the guard will roll it back (its `roots`
+/// sum of the root coupling's velocities and the pass's, non-finite), what it transmits to
+/// the colliders and the head. Returns, per lane, the [`component_sum`]s of the velocities
+/// it wrote, added.
 #[inline(never)]
 fn block_pass<
     M: Math,
@@ -680,14 +694,15 @@ fn block_pass<
     ctx: &StepContext,
     setup: &Setup,
     (block, start): (&mut DftlBlock<W, N>, &BlockState<W, N>),
+    roots: Wide<W>,
     accelerations: Option<&[Vec3]>,
     report: &mut StepReport,
-) -> (Wide<W>, [Vec3; W]) {
+) -> Wide<W> {
     let setup = setup.with_switches(SHAPE, INEXTENSIBLE, DRAG);
     let max_nodes = block.max_nodes.min(N);
     let mut velocity_total = Wide::splat(0.0);
     if max_nodes < 3 {
-        return (velocity_total, [Vec3::ZERO; W]);
+        return velocity_total;
     }
     let nodes = block.nodes;
     let nodes_real = Wide::new(core::array::from_fn(|l| nodes[l] as Real));
@@ -743,8 +758,9 @@ fn block_pass<
     // slower).
     let momenta = lost_momenta(&setup, (block, start), accelerations, (nodes_real, common));
     let measured = (&measures, &collider_push, momenta);
-    let head_forces = tally_lanes::<M, W, N>(ctx, &setup, block, measured, report);
-    (velocity_total, head_forces)
+    let verdict = not_finite_sum(roots + velocity_total);
+    tally_lanes::<M, W, N>(ctx, &setup, (block, verdict), measured, report);
+    velocity_total
 }
 
 /// The lanes where node `k` is free (node 1 is held) and exists.
@@ -905,30 +921,26 @@ fn handing_lanes<const W: usize>(
     )
 }
 
-/// Each lane's tally into the report, in lane order. Returns each lane's force on the head
-/// (`Tally::head_force`).
+/// Each lane's tally into the report, in lane order, as the per-strand path's: its measures,
+/// then, where the guard will keep the lane's step (`verdict` 0), its pushes on the scene's
+/// colliders in use and its force on the head (`Tally::head_force`).
 fn tally_lanes<M: Math, const W: usize, const N: usize>(
     ctx: &StepContext,
     setup: &Setup,
-    block: &DftlBlock<W, N>,
+    (block, verdict): (&DftlBlock<W, N>, Wide<W>),
     (measures, collider_push, momenta): (
         &Measures<Wide<W>>,
         &ColliderPush<Wide<W>>,
         Momenta<Wide<W>>,
     ),
     report: &mut StepReport,
-) -> [Vec3; W] {
+) {
     let (stretch, contact_stretch) = measures.stretches::<M>();
-    let mut head_forces = [Vec3::ZERO; W];
     // The pushes on the scene's colliders in use (none with collisions off), gathered from
     // the lanes for those only.
     let in_use = ctx.colliders().len().min(MAX_COLLIDERS);
     let mut lane_push = [V3::<Real>::zero(); MAX_COLLIDERS];
-    for (l, head_force) in head_forces
-        .iter_mut()
-        .enumerate()
-        .take(block.strands.min(W))
-    {
+    for l in 0..block.strands.min(W) {
         for (push, lanes) in lane_push.iter_mut().zip(collider_push).take(in_use) {
             *push = V3::from(lanes.lane(l));
         }
@@ -942,10 +954,11 @@ fn tally_lanes<M: Math, const W: usize, const N: usize>(
             lost,
             head_force: Tally::head_force(lost, push, setup.inv_dt),
         };
-        tally.report(report, push, setup.inv_dt);
-        *head_force = tally.head_force;
+        tally.report(report);
+        let rolled_back = verdict.0[l] != 0.0;
+        transmit_to_colliders(push, setup.inv_dt, rolled_back, report);
+        transmit_to_head(tally.head_force, rolled_back, report);
     }
-    head_forces
 }
 
 #[cfg(test)]

@@ -113,20 +113,23 @@ fn block_gives_the_bits_of_the_per_strand_path() {
             }
         }
         // Both colliders reached in every configuration: the contact branches ran too.
-        let contacts = block_matches_per_strand(&effects);
+        let contacts = block_matches_per_strand::<5, 4>(&effects);
+        assert!(contacts > 0, "{effects:?}");
+        // Twelve strands in blocks of 8 lanes (the second with four strands).
+        let contacts = block_matches_per_strand::<12, 8>(&effects);
         assert!(contacts > 0, "{effects:?}");
     }
 }
 
-/// A world of five wavy strands of 10 to 14 nodes with `effects`, a head sphere and a capsule
+/// A world of `S` wavy strands of 10 to 14 nodes with `effects`, a head sphere and a capsule
 /// across the strands 5 cm above the roots (they touch it with shape on too).
-fn world(effects: &[Effect]) -> World<5, 16, Libm> {
+fn world<const S: usize>(effects: &[Effect]) -> World<S, 16, Libm> {
     let p = Params {
         effects: Effects::from_slice(effects),
         drag: 2.0e-7,
         ..params(&[])
     };
-    let mut w: World<5, 16, Libm> = World::with_params(p).unwrap();
+    let mut w: World<S, 16, Libm> = World::with_params(p).unwrap();
     let sphere = Shape::Sphere {
         centre: Vec3::ZERO,
         radius: 0.05,
@@ -143,8 +146,8 @@ fn world(effects: &[Effect]) -> World<5, 16, Libm> {
         };
         w.add_collider(collider).unwrap();
     }
-    for s in 0..5 {
-        let points = wavy(10 + s, s as Real);
+    for s in 0..S {
+        let points = wavy(10 + s % 5, s as Real);
         w.add_strand(Strand::from_polyline(&points, &Material::HUMAN_HAIR).unwrap())
             .unwrap();
     }
@@ -172,39 +175,58 @@ fn bits(r: &StepReport) -> [u32; 12] {
     .map(Real::to_bits)
 }
 
-/// Steps both paths 300 steps and checks they agree (state, report); returns the
-/// contacts seen.
-fn block_matches_per_strand(effects: &[Effect]) -> u32 {
-    let mut w = world(effects);
+/// Steps `S` strands by both paths, in blocks of `W` lanes, 300 steps and checks they agree
+/// (state, report); at step 150 a NaN acceleration on the second-last strand rolls it back,
+/// and neither path reports a force that is not finite.
+/// Returns the contacts seen.
+fn block_matches_per_strand<const S: usize, const W: usize>(effects: &[Effect]) -> u32 {
+    let mut w = world::<S>(effects);
     let p = *w.params();
-    let mut blocks: [DftlBlock<4, 16>; 2] = [
-        DftlBlock::from_strands(&w.strands()[..4]),
-        DftlBlock::from_strands(&w.strands()[4..]),
-    ];
+    let mut blocks: std::vec::Vec<DftlBlock<W, 16>> =
+        w.strands().chunks(W).map(DftlBlock::from_strands).collect();
     let coefficients = p.dftl.at_step(p.dt);
     let mut previous = Pose::IDENTITY;
     let mut contacts = 0;
+    let mut accelerations = std::vec![Vec3::ZERO; S * 16];
     for k in 0..300u32 {
         let t = (k + 1) as Real * p.dt;
         let head = Shake::TEN_RAD_PER_S.pose_at::<Libm>(t);
+        accelerations[(S - 2) * 16 + 5].x = if k == 150 { Real::NAN } else { 0.0 };
         let report = w.step(&StepInput {
             head,
-            accelerations: None,
+            accelerations: Some(&accelerations),
         });
+        assert_eq!(
+            report.rolled_back,
+            u32::from(k == 150),
+            "{effects:?} step {k}"
+        );
         let colliders = w.colliders();
         let ctx =
             StepContext::with_coefficients(&p, coefficients, previous, head, colliders).at_time(t);
         let mut block_report = StepReport::default();
-        step_blocks::<Libm, 4, 16>(&ctx, &mut blocks, 0, None, &mut block_report);
+        let a = Some(&accelerations[..]);
+        step_blocks::<Libm, W, 16>(&ctx, &mut blocks, 0, a, &mut block_report);
+        assert_eq!(report.rolled_back, block_report.rolled_back, "{effects:?}");
         previous = head;
         assert_eq!(report.stage_runs, block_report.stage_runs, "{effects:?}");
         assert_eq!(bits(&report), bits(&block_report), "{effects:?} step {k}");
+        // The strand that went NaN passes nothing on: its pushes are not reported.
+        let forces = block_report
+            .collider_forces
+            .iter()
+            .chain([&block_report.head_force]);
+        assert!(
+            forces.into_iter().all(|f| f.is_finite()),
+            "{effects:?} step {k}"
+        );
         assert_eq!(report.contacts, block_report.contacts, "{effects:?}");
         contacts += report.contacts;
     }
     let mut strands: std::vec::Vec<Strand<16>> = w.strands().to_vec();
-    blocks[0].store(&mut strands[..4]);
-    blocks[1].store(&mut strands[4..]);
+    for (block, chunk) in blocks.iter().zip(strands.chunks_mut(W)) {
+        block.store(chunk);
+    }
     let hash = crate::hash::state_hash(&strands);
     assert_eq!(hash, w.state_hash(), "{effects:?}");
     assert!(w.strands()[4].state.position[10].y != points_y(&wavy(14, 4.0)));
