@@ -19,8 +19,8 @@ use hairsim_core::{
     Strand, Vec3,
 };
 
-/// Lanes per block: 16 measured fastest on this machine's SSE2 baseline (8 spills registers
-/// badly; see the report).
+/// Lanes per block of the wide rows, beside the harness's 8 (`RECOMMENDED_LANES`): a pass
+/// over 16 lanes spills the SSE2 registers, and these rows show what that costs.
 const W: usize = 16;
 
 /// `libm`'s trigonometry, the hardware's correctly rounded square root (vectorisable).

@@ -30,13 +30,11 @@ use crate::strand::Strand;
 
 use super::node::NodeInput;
 
-/// Lanes per block the harness uses on x86-64. Since the lanes' masks are whole 32-bit lanes
-/// (`lane::WideMask`, 2026-12-05), 8 lanes run as fast as 16 did with byte masks, or faster:
-/// `dftl_cpu`'s medians of three runs, M vertex-steps per CPU-second, 8 lanes now against
-/// 16 then, DFTL + shape 66.7 / 57.1 (1,024 × 8), 66.6 / 64.5 (1,024 × 32), 60.4 / 58.6
-/// (4,096 × 32), 56.9 / 51.1 (4,096 × 64), 53.8 / 56.9 (16,384 × 64); 16 lanes with the new
-/// masks spill (each mask takes four SSE2 registers) and lost 5–15 %. Before, with masks of
-/// `bool`s, 16 lanes were the fastest on SSE2 and with AVX2 (the same bits either way).
+/// Lanes per block the harness uses on x86-64. With the lanes' masks as whole 32-bit lanes
+/// (`lane::WideMask`), a vector or a mask of 8 lanes takes two of SSE2's sixteen registers
+/// and one of 16 lanes four: a pass over 16 lanes spills and runs 5–15 % slower (`dftl_cpu`,
+/// DFTL + shape, M vertex-steps per CPU-second; `docs/design-departures.md`). The bits are
+/// the same at any width.
 pub const RECOMMENDED_LANES: usize = 8;
 
 /// `W` values, one per strand of a block.
