@@ -652,12 +652,11 @@ fn step_block_with<M: Math, const W: usize, const N: usize>(
     // Lines 16–27 in one pass from the root, all lanes together.
     count_constraints(setup, lanes, report);
     let at = (&mut *block, &last_good);
-    let pass = with_effect_switches!(
+    let verdict = with_effect_switches!(
         setup,
         block_pass::<M, W, N>(ctx, setup, at, roots, accelerations, report)
     );
     // Quarantine: a lane that wrote a non-finite value gets its last good positions back.
-    let verdict = not_finite_sum(roots + pass);
     guard(
         block,
         &last_good,
@@ -680,8 +679,9 @@ struct Carried<'a, const W: usize> {
 /// The whole pass over the nodes of a block with the effect switches fixed, and each lane's
 /// tally into the report: its measures and, unless the guard will roll it back (its `roots`
 /// sum of the root coupling's velocities and the pass's, non-finite), what it transmits to
-/// the colliders and the head. Returns, per lane, the [`component_sum`]s of the velocities
-/// it wrote, added.
+/// the colliders and the head. Returns that verdict per lane: `roots` plus the
+/// [`component_sum`]s of the velocities the pass wrote, through [`not_finite_sum`] (0 where
+/// every value was finite).
 #[inline(never)]
 fn block_pass<
     M: Math,
@@ -702,7 +702,7 @@ fn block_pass<
     let max_nodes = block.max_nodes.min(N);
     let mut velocity_total = Wide::splat(0.0);
     if max_nodes < 3 {
-        return velocity_total;
+        return not_finite_sum(roots);
     }
     let nodes = block.nodes;
     let nodes_real = Wide::new(core::array::from_fn(|l| nodes[l] as Real));
@@ -760,7 +760,7 @@ fn block_pass<
     let measured = (&measures, &collider_push, momenta);
     let verdict = not_finite_sum(roots + velocity_total);
     tally_lanes::<M, W, N>(ctx, &setup, (block, verdict), measured, report);
-    velocity_total
+    verdict
 }
 
 /// The lanes where node `k` is free (node 1 is held) and exists.
